@@ -1,0 +1,19 @@
+"""simkit: multi-antenna GNSS/INS simulation with exact truth, and the tools that check what consumes it."""
+from __future__ import annotations
+
+__version__ = "0.1.0"
+SCHEMA_VERSION = 1
+
+
+def run(scenario, out=None, seed=None, overrides=None, progress=False):
+    """Simulate ``scenario`` (a TOML path, a bundled name or a dict) into an HDF5 file; returns its Path."""
+    from .pipeline import run as _run
+
+    return _run(scenario, out=out, seed=seed, overrides=overrides, progress=progress)
+
+
+def open(path):  # noqa: A001 - the documented API name
+    """Open a simkit HDF5 file lazily (see :class:`simkit.io.reader.Dataset`)."""
+    from .io.reader import open_dataset
+
+    return open_dataset(path)

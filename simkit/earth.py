@@ -1,0 +1,64 @@
+"""WGS-84 Earth model: constants, radii of curvature, normal gravity, Earth and transport rates.
+
+All angles in radians, heights in metres above the ellipsoid, vectors in the local-level ENU frame (n).
+Gravity follows NIMA TR8350.2: closed-form Somigliana (eq. 4-1) times the height series of eq. 4-3; it
+contains the centrifugal part and acts along minus the ellipsoid normal. Truth and estimators both use it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+A = 6378137.0                      # semi-major axis, m
+F = 1.0 / 298.257223563            # flattening
+B = A * (1.0 - F)                  # semi-minor axis, m
+E2 = F * (2.0 - F)                 # first eccentricity squared
+OMEGA_E = 7.292115e-5              # WGS-84 Earth rotation rate, rad/s
+GM = 3.986004418e14                # m^3/s^2
+GAMMA_E = 9.7803253359             # normal gravity at the equator, m/s^2
+K_SOMIGLIANA = 0.00193185265241    # (b*gamma_p)/(a*gamma_e) - 1
+M_RATIO = OMEGA_E**2 * A**2 * B / GM  # 0.00344978650684
+C_LIGHT = 299792458.0              # m/s
+
+
+def radii(lat):
+    """Meridian (R_M) and prime-vertical (R_N) radii of curvature at geodetic latitude ``lat`` (rad), m."""
+    s2 = np.sin(lat) ** 2
+    w = np.sqrt(1.0 - E2 * s2)
+    rn = A / w
+    rm = A * (1.0 - E2) / w**3
+    return rm, rn
+
+
+def normal_gravity(lat, h):
+    """Magnitude of WGS-84 normal gravity (m/s^2) at geodetic latitude ``lat`` (rad) and height ``h`` (m)."""
+    s2 = np.sin(lat) ** 2
+    g0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / np.sqrt(1.0 - E2 * s2)
+    return g0 * (1.0 - 2.0 / A * (1.0 + F + M_RATIO - 2.0 * F * s2) * h + 3.0 * h**2 / A**2)
+
+
+def gravity_enu(lat, h):
+    """Normal gravity vector in ENU, (..., 3) m/s^2: [0, 0, -gamma(lat, h)]."""
+    g = np.asarray(normal_gravity(lat, h), dtype=float)
+    out = np.zeros(g.shape + (3,))
+    out[..., 2] = -g
+    return out
+
+
+def earth_rate_enu(lat):
+    """Earth rotation rate w_ie^n in ENU, (..., 3) rad/s."""
+    lat = np.asarray(lat, dtype=float)
+    out = np.zeros(lat.shape + (3,))
+    out[..., 1] = OMEGA_E * np.cos(lat)
+    out[..., 2] = OMEGA_E * np.sin(lat)
+    return out
+
+
+def transport_rate_enu(lat, h, vel_enu):
+    """Transport rate w_en^n in ENU, (..., 3) rad/s, for velocity ``vel_enu`` (m/s, relative to Earth)."""
+    rm, rn = radii(lat)
+    v = np.asarray(vel_enu, dtype=float)
+    out = np.empty(v.shape)
+    out[..., 0] = -v[..., 1] / (rm + h)
+    out[..., 1] = v[..., 0] / (rn + h)
+    out[..., 2] = v[..., 0] * np.tan(lat) / (rn + h)
+    return out

@@ -1,0 +1,99 @@
+"""Frames and attitude: ECEF <-> geodetic (pymap3d, WGS-84), ECEF <-> ENU rotations, Euler <-> rotation.
+
+Conventions (DESIGN.md): navigation frame n = local-level ENU; body frame b = x right, y forward, z up.
+Attitude is the rotation body -> ENU (``scipy.spatial.transform.Rotation``, quaternions scalar-last) built as
+C_b^n = R_z(yaw) R_x(pitch) R_y(roll) with yaw = -heading (heading clockwise from north). Euler triples are
+ordered [pitch, roll, heading]. Positive pitch is nose up, positive roll is right wing down.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pymap3d
+from scipy.spatial.transform import Rotation
+
+from . import earth
+
+_ELL = pymap3d.Ellipsoid.from_name("wgs84")
+# ENU <-> NED and body right-forward-up <-> forward-right-down: the same proper rotation (it is its own inverse)
+SWAP = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+
+
+def lla_to_ecef(lat, lon, h):
+    """Geodetic (rad, rad, m) -> ECEF (..., 3) m."""
+    x, y, z = pymap3d.geodetic2ecef(lat, lon, h, ell=_ELL, deg=False)
+    return np.stack(np.broadcast_arrays(x, y, z), axis=-1).astype(float)
+
+
+def ecef_to_lla(pos):
+    """ECEF (..., 3) m -> geodetic (..., 3): lat rad, lon rad, ellipsoidal height m."""
+    pos = np.asarray(pos, dtype=float)
+    lat, lon, h = pymap3d.ecef2geodetic(pos[..., 0], pos[..., 1], pos[..., 2], ell=_ELL, deg=False)
+    return np.stack(np.broadcast_arrays(lat, lon, h), axis=-1).astype(float)
+
+
+def ecef_to_enu_matrix(lat, lon):
+    """Rotation matrices C_e^n (..., 3, 3) taking ECEF vectors to ENU at (lat, lon) in radians."""
+    sl, cl = np.sin(lat), np.cos(lat)
+    so, co = np.sin(lon), np.cos(lon)
+    z = np.zeros_like(sl * so)
+    return np.stack(
+        [
+            np.stack([-so + z, co + z, z], -1),
+            np.stack([-sl * co, -sl * so, cl + z], -1),
+            np.stack([cl * co, cl * so, sl + z], -1),
+        ],
+        -2,
+    )
+
+
+def ecef_to_enu_vec(vec, lat, lon):
+    """Rotate ECEF vectors (..., 3) into ENU at (lat, lon)."""
+    return np.einsum("...ij,...j->...i", ecef_to_enu_matrix(lat, lon), vec)
+
+
+def enu_to_ecef_vec(vec, lat, lon):
+    """Rotate ENU vectors (..., 3) at (lat, lon) into ECEF."""
+    return np.einsum("...ji,...j->...i", ecef_to_enu_matrix(lat, lon), vec)
+
+
+def attitude_from_euler(pitch, roll, heading) -> Rotation:
+    """Body -> ENU rotation(s) from pitch, roll, heading (rad)."""
+    yaw = -np.asarray(heading, dtype=float)
+    angles = np.stack(np.broadcast_arrays(yaw, np.asarray(pitch, float), np.asarray(roll, float)), axis=-1)
+    return Rotation.from_euler("ZXY", angles)
+
+
+def euler_from_attitude(rot: Rotation) -> np.ndarray:
+    """Body -> ENU rotation(s) -> Euler (..., 3) [pitch, roll, heading] rad, heading in [0, 2 pi)."""
+    import warnings
+
+    with warnings.catch_warnings():  # gimbal lock at pitch = +-90 deg is a legitimate attitude (loops)
+        warnings.simplefilter("ignore", UserWarning)
+        yzr = rot.as_euler("ZXY")
+    heading = np.mod(-yzr[..., 0], 2.0 * np.pi)
+    return np.stack([yzr[..., 1], yzr[..., 2], heading], axis=-1)
+
+
+def enu_to_ned(vec):
+    """ENU vectors (..., 3) -> NED; the same swap takes body right-forward-up to forward-right-down."""
+    return np.asarray(vec, dtype=float) @ SWAP.T
+
+
+ned_to_enu = enu_to_ned  # the swap is an involution
+
+
+def attitude_to_ned_frd(rot: Rotation) -> Rotation:
+    """Body(RFU) -> ENU attitude -> body(FRD) -> NED attitude, for users of the aerospace convention."""
+    s = Rotation.from_matrix(SWAP)
+    return s * rot * s
+
+
+def attitude_from_ned_frd(rot: Rotation) -> Rotation:
+    """Body(FRD) -> NED attitude -> body(RFU) -> ENU attitude."""
+    return attitude_to_ned_frd(rot)
+
+
+def gravity_ecef(pos_ecef):
+    """WGS-84 normal gravity vector (..., 3) in ECEF at ECEF positions (m/s^2)."""
+    lla = ecef_to_lla(pos_ecef)
+    return enu_to_ecef_vec(earth.gravity_enu(lla[..., 0], lla[..., 2]), lla[..., 0], lla[..., 1])
