@@ -1,0 +1,211 @@
+"""The [gnss] scenario section: typed, validated configuration of the GNSS observables stage.
+
+Every key carries its unit in its name; see docs/gnss.md for the full table. ``parse_config(section)`` calls
+``done()`` on every table it reads, so a misspelt key is an error naming its dotted path.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ScenarioError
+from ..scenario.fields import Section, in_range, non_negative, positive
+from . import clock, signals
+
+ERROR_TERMS = ("receiver_clock", "satellite_clock", "group_delay", "ionosphere", "troposphere", "multipath",
+               "noise", "cycle_slips")
+
+
+@dataclass(frozen=True)
+class Antenna:
+    lever_arm_b: np.ndarray      # (3,) m, phase centre from the IMU centre, body frame
+    boresight_b: np.ndarray      # (3,) unit vector, body frame
+    horizon_mask_rad: float      # satellites less than this above the antenna's horizon plane are masked
+    rolloff_db: float            # gain at the antenna horizon relative to boresight (dB, >= 0)
+
+
+@dataclass(frozen=True)
+class NoiseConfig:
+    model: str                   # "cn0" (tracking-loop jitter from C/N0) or "constant"
+    code_sigma_m: float
+    carrier_sigma_m: float
+    doppler_sigma_hz: float
+    dll_bandwidth_hz: float
+    pll_bandwidth_hz: float
+    fll_bandwidth_hz: float
+    correlator_spacing_chips: float
+    integration_time_s: float
+
+
+@dataclass(frozen=True)
+class MultipathConfig:
+    code_sigma_m: float          # at the horizon
+    carrier_sigma_m: float       # at the horizon
+    elevation_scale_rad: float
+    correlation_time_s: float
+
+
+@dataclass(frozen=True)
+class ScheduledSlip:
+    t_s: float
+    sat: str | None              # None: every satellite
+    antenna: int | None          # None: every antenna
+    signal: str | None           # None: every signal
+    cycles: int | None           # None: a random non-zero jump
+
+
+@dataclass(frozen=True)
+class Outage:
+    start_s: float
+    end_s: float
+    sats: tuple[str, ...] | None
+    antennas: tuple[int, ...] | None
+
+
+@dataclass(frozen=True)
+class GnssConfig:
+    rate_hz: float
+    elevation_mask_rad: float
+    sources: tuple[str, ...]
+    antennas: tuple[Antenna, ...]
+    signals: tuple[str, ...]
+    clock_mode: str              # "per_antenna" or "common"
+    oscillator: clock.Oscillator
+    oscillator_name: str
+    errors: dict[str, bool]
+    cn0_zenith_dbhz: float
+    noise: NoiseConfig
+    multipath: MultipathConfig
+    slip_rate_per_h: float
+    slips: tuple[ScheduledSlip, ...]
+    outages: tuple[Outage, ...]
+    ambiguity_max_cycles: int
+    iono_coefficients: dict[str, tuple] = field(default_factory=dict)  # "gps"/"bds" -> (alpha, beta) overrides
+
+
+def _unit(v, key_section: Section, name: str) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    n = np.linalg.norm(v)
+    if n == 0.0:
+        raise key_section.error(name, "must be a non-zero vector")
+    return v / n
+
+
+def parse_config(sec: Section) -> GnssConfig:
+    """Read and validate the [gnss] table (``sec`` at path "gnss"). Raises ScenarioError naming the key."""
+    rate = sec.get("rate_hz", float, 1.0, check=positive)
+    mask = sec.get("elevation_mask_deg", float, 10.0, check=in_range(-90.0, 90.0))
+    sigs = sec.get("signals", str, ["L1C"], shape=0)
+    if not sigs:
+        raise sec.error("signals", "expected at least one signal")
+    for s in sigs:
+        if s not in signals.SIGNALS:
+            raise sec.error("signals", f"unknown signal {s!r} (known: {', '.join(signals.SIGNALS)})")
+    if len(set(sigs)) != len(sigs):
+        raise sec.error("signals", f"duplicate signal in {sigs!r}")
+
+    sources = []
+    for c in sec.sections("constellation", required=True):
+        sources.append(c.get("source", str))
+        c.done()
+    if not sources:
+        raise sec.error("constellation", "expected at least one [[gnss.constellation]]")
+
+    antennas = []
+    for a in sec.sections("antenna", required=True):
+        antennas.append(Antenna(
+            lever_arm_b=np.asarray(a.get("lever_arm_m", float, shape=3)),
+            boresight_b=_unit(a.get("boresight_b", float, [0.0, 0.0, 1.0], shape=3), a, "boresight_b"),
+            horizon_mask_rad=np.radians(a.get("horizon_mask_deg", float, 0.0, check=in_range(-90.0, 90.0))),
+            rolloff_db=a.get("rolloff_db", float, 10.0, check=non_negative)))
+        a.done()
+    if not antennas:
+        raise sec.error("antenna", "expected at least one [[gnss.antenna]]")
+
+    clock_mode = sec.get("clock", str, "common", choices=("common", "per_antenna"))
+    osc_name = sec.get("oscillator", str, "tcxo", choices=tuple(clock.PRESETS))
+
+    err = sec.section("errors")
+    errors = {k: err.get(k, bool, True) for k in ERROR_TERMS}
+    err.done()
+
+    nz = sec.section("noise")
+    noise = NoiseConfig(
+        model=nz.get("model", str, "cn0", choices=("cn0", "constant")),
+        code_sigma_m=nz.get("code_sigma_m", float, 0.3, check=non_negative),
+        carrier_sigma_m=nz.get("carrier_sigma_m", float, 0.002, check=non_negative),
+        doppler_sigma_hz=nz.get("doppler_sigma_hz", float, 0.05, check=non_negative),
+        dll_bandwidth_hz=nz.get("dll_bandwidth_hz", float, 1.0, check=positive),
+        pll_bandwidth_hz=nz.get("pll_bandwidth_hz", float, 15.0, check=positive),
+        fll_bandwidth_hz=nz.get("fll_bandwidth_hz", float, 2.0, check=positive),
+        correlator_spacing_chips=nz.get("correlator_spacing_chips", float, 0.5, check=in_range(0.01, 1.0)),
+        integration_time_s=nz.get("integration_time_s", float, 0.02, check=positive))
+    nz.done()
+
+    mp = sec.section("multipath")
+    multipath = MultipathConfig(
+        code_sigma_m=mp.get("code_sigma_m", float, 1.0, check=non_negative),
+        carrier_sigma_m=mp.get("carrier_sigma_m", float, 0.01, check=non_negative),
+        elevation_scale_rad=np.radians(mp.get("elevation_scale_deg", float, 20.0, check=positive)),
+        correlation_time_s=mp.get("correlation_time_s", float, 30.0, check=positive))
+    mp.done()
+
+    slip_rate = sec.get("slip_rate_per_h", float, 0.0, check=non_negative)
+    slips = []
+    for s in sec.sections("slip"):
+        sig = s.get("signal", str, None)
+        if sig is not None and sig not in sigs:
+            raise s.error("signal", f"must be one of gnss.signals {sigs!r}")
+        ant = s.get("antenna", int, None, check=in_range(0, len(antennas) - 1))
+        cyc = s.get("cycles", int, None)
+        if cyc == 0:
+            raise s.error("cycles", "a slip must be a non-zero number of cycles")
+        slips.append(ScheduledSlip(s.get("t_s", float, check=non_negative), s.get("sat", str, None), ant, sig, cyc))
+        s.done()
+
+    outages = []
+    for o in sec.sections("outage"):
+        start = o.get("start_s", float, check=non_negative)
+        end = o.get("end_s", float, check=lambda v: None if v > start else "must be > start_s")
+        sats = o.get("sats", str, None, shape=0)
+        ants = o.get("antennas", int, None, shape=0)
+        if ants is not None and any(not 0 <= a < len(antennas) for a in ants):
+            raise o.error("antennas", f"antenna indices must be in [0, {len(antennas) - 1}]")
+        outages.append(Outage(start, end, tuple(sats) if sats is not None else None,
+                              tuple(ants) if ants is not None else None))
+        o.done()
+
+    iono = {}
+    io = sec.section("ionosphere")
+    for system in ("gps", "bds"):
+        a = io.get(f"{system}_alpha", float, None, shape=4)
+        b = io.get(f"{system}_beta", float, None, shape=4)
+        if (a is None) != (b is None):
+            raise io.error(f"{system}_alpha" if a is None else f"{system}_beta",
+                           f"give both {system}_alpha and {system}_beta")
+        if a is not None:
+            iono[system] = (tuple(a), tuple(b))
+    io.done()
+
+    cfg = GnssConfig(
+        rate_hz=rate, elevation_mask_rad=np.radians(mask), sources=tuple(sources), antennas=tuple(antennas),
+        signals=tuple(sigs), clock_mode=clock_mode, oscillator=clock.PRESETS[osc_name], oscillator_name=osc_name,
+        errors=errors, cn0_zenith_dbhz=sec.get("cn0_zenith_dbhz", float, 45.0, check=in_range(10.0, 70.0)),
+        noise=noise, multipath=multipath, slip_rate_per_h=slip_rate, slips=tuple(slips), outages=tuple(outages),
+        ambiguity_max_cycles=sec.get("ambiguity_max_cycles", int, 100000, check=in_range(0, 10**8)),
+        iono_coefficients=iono)
+    sec.done()
+    return cfg
+
+
+def check_sats(cfg: GnssConfig, sat_ids) -> None:
+    """Scheduled slips/outages must name satellites that exist in the loaded constellations."""
+    known = set(sat_ids)
+    for i, s in enumerate(cfg.slips):
+        if s.sat is not None and s.sat not in known:
+            raise ScenarioError(f"gnss.slip[{i}].sat", f"unknown satellite {s.sat!r}")
+    for i, o in enumerate(cfg.outages):
+        for s in o.sats or ():
+            if s not in known:
+                raise ScenarioError(f"gnss.outage[{i}].sats", f"unknown satellite {s!r}")
