@@ -1,1 +1,17 @@
-"""ambiguity"""
+"""The bundled LAMBDA ambiguity solver: decorrelation, integer least squares, success rates, validation,
+partial fixing and the baseline-constrained (attitude) solvers. See docs/ambiguity.md."""
+from .decorrelation import Decorrelation, decorrelate, ltdl
+from .enumeration import enumerate_ils
+from .errors import AmbiguityInputError
+from .estimators import bootstrapping, rounding
+from .search import DEFAULT_MAX_NODES, ILSBatchResult, ILSResult, ils, ils_batch
+from .success import (adop, adop_success_rate, adop_upper_bound, bootstrap_success_rate, monte_carlo_success_rate,
+                      success_rate_bounds)
+from .validation import DEFAULT_RATIO_THRESHOLD, PartialFix, ffrt, ffrt_threshold, partial_fix, ratio_test
+
+__all__ = [
+    "AmbiguityInputError", "DEFAULT_MAX_NODES", "DEFAULT_RATIO_THRESHOLD", "Decorrelation", "ILSBatchResult",
+    "ILSResult", "PartialFix", "adop", "adop_success_rate", "adop_upper_bound", "bootstrap_success_rate",
+    "bootstrapping", "decorrelate", "enumerate_ils", "ffrt", "ffrt_threshold", "ils", "ils_batch", "ltdl",
+    "monte_carlo_success_rate", "partial_fix", "ratio_test", "rounding", "success_rate_bounds",
+]

@@ -1,0 +1,203 @@
+"""LtDL factorisation and LAMBDA decorrelation (integer Gauss transforms and permutations).
+
+Conventions (de Jonge & Tiberius 1996, LGR-12):
+- ``Q = L^T diag(d) L`` with ``L`` unit lower-triangular; ``d[i]`` is the variance of ambiguity ``i`` conditioned on
+  ambiguities ``i+1 .. n-1`` (the sequential search starts at index ``n-1``).
+- Decorrelated ambiguities ``z = Z^T a``, ``Q_z = Z^T Q Z``, ``Z`` unimodular (integer, ``|det Z| = 1``);
+  ``Zti = Z^{-T}`` (also integer) maps back: ``a = Zti z``.
+The reduction follows the LAMBDA 3.0 ordering of operations (Gauss transforms on column ``i`` whenever ``i`` is at
+or below the last swap position, swap when ``d[i] + L[i+1,i]^2 d[i+1] < d[i+1]``, restart from the top after a swap),
+so that the conditional variances match the published LAMBDA 3.0 results.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from .errors import AmbiguityInputError
+
+# status codes shared by the kernels: 0 finished, 1 work cap reached, negative = input error
+OK, NOT_FINISHED, ERR_NONFINITE, ERR_ASYMMETRIC, ERR_NOT_PD = 0, 1, -1, -2, -3
+SYMMETRY_RTOL = 1e-9  # |Q_ij - Q_ji| allowed, relative to sqrt(Q_ii Q_jj)
+PIVOT_RTOL = 1e-14  # a conditional variance below this times max(diag Q) counts as not positive definite
+
+
+@njit(cache=True)
+def check_matrix(Q):
+    """(code, i, j): 0 if Q is finite and symmetric, else the error code and the offending indices."""
+    n = Q.shape[0]
+    for i in range(n):
+        for j in range(n):
+            if not math.isfinite(Q[i, j]):
+                return ERR_NONFINITE, i, j
+    for i in range(n):
+        for j in range(i):
+            scale = math.sqrt(abs(Q[i, i] * Q[j, j]))
+            if abs(Q[i, j] - Q[j, i]) > SYMMETRY_RTOL * scale:
+                return ERR_ASYMMETRIC, i, j
+    return OK, 0, 0
+
+
+@njit(cache=True)
+def ltdl_into(Q, L, d):
+    """Fill ``L`` (unit lower-triangular) and ``d`` with ``Q = L^T diag(d) L``, reading Q's lower triangle.
+
+    Returns -1 on success, else the index of the first non-positive conditional variance.
+    """
+    n = Q.shape[0]
+    A = np.empty((n, n))
+    big = 0.0
+    for i in range(n):
+        big = max(big, Q[i, i])
+        for j in range(i + 1):
+            A[i, j] = Q[i, j]
+    for i in range(n - 1, -1, -1):
+        di = A[i, i]
+        if not di > PIVOT_RTOL * big:
+            return i
+        d[i] = di
+        for j in range(i):
+            L[i, j] = A[i, j] / di
+        L[i, i] = 1.0
+        for j in range(i + 1, n):
+            L[i, j] = 0.0
+        for j in range(i):
+            aij = A[i, j]
+            for k in range(j + 1):
+                A[j, k] -= L[i, k] * aij
+    return -1
+
+
+@njit(cache=True)
+def _round_half_away(x):
+    return math.copysign(math.floor(abs(x) + 0.5), x)
+
+
+@njit(cache=True)
+def reduce_into(L, d, Z, Zti):
+    """Decorrelate in place: integer Gauss transforms and permutations on (L, d), accumulated into Z and Zti.
+
+    ``Z`` and ``Zti`` must hold the identity (int64) on entry.
+    """
+    n = d.shape[0]
+    last_swap = n - 2
+    i = n - 2
+    while i >= 0:
+        if i <= last_swap:
+            for j in range(i + 1, n):
+                mu = _round_half_away(L[j, i])
+                if mu != 0.0:
+                    for k in range(j, n):
+                        L[k, i] -= mu * L[k, j]
+                    imu = np.int64(mu)
+                    for k in range(n):
+                        Z[k, i] -= imu * Z[k, j]
+                        Zti[k, j] += imu * Zti[k, i]
+        lij = L[i + 1, i]
+        delta = d[i] + lij * lij * d[i + 1]
+        if delta < d[i + 1]:
+            lam = d[i + 1] * lij / delta
+            eta = d[i] / delta
+            d[i] = eta * d[i + 1]
+            d[i + 1] = delta
+            for k in range(i):
+                a0 = L[i, k]
+                a1 = L[i + 1, k]
+                L[i, k] = -lij * a0 + a1
+                L[i + 1, k] = eta * a0 + lam * a1
+            L[i + 1, i] = lam
+            for k in range(i + 2, n):
+                t = L[k, i]
+                L[k, i] = L[k, i + 1]
+                L[k, i + 1] = t
+            for k in range(n):
+                t = Z[k, i]
+                Z[k, i] = Z[k, i + 1]
+                Z[k, i + 1] = t
+                t = Zti[k, i]
+                Zti[k, i] = Zti[k, i + 1]
+                Zti[k, i + 1] = t
+            last_swap = i
+            i = n - 2
+        else:
+            i -= 1
+
+
+def raise_for_status(code: int, i: int, j: int, what: str = "Q") -> None:
+    """Turn a kernel error code into :class:`AmbiguityInputError` naming the element at fault."""
+    if code == ERR_NONFINITE:
+        raise AmbiguityInputError(what, f"element [{i}, {j}] is not finite; expected a finite covariance matrix")
+    if code == ERR_ASYMMETRIC:
+        raise AmbiguityInputError(
+            what, f"not symmetric: [{i}, {j}] and [{j}, {i}] differ by more than {SYMMETRY_RTOL:g} relative")
+    if code == ERR_NOT_PD:
+        raise AmbiguityInputError(
+            what, f"not positive definite: conditional variance {i} of the LtDL factorisation is <= 0 (or below "
+                  f"{PIVOT_RTOL:g} x max diagonal); expected a positive-definite covariance matrix")
+
+
+def as_problem(a_hat, Q, what: str = ""):
+    """Float64 contiguous (a_hat (n,), Q (n, n)) or :class:`AmbiguityInputError` naming what is wrong."""
+    a = np.ascontiguousarray(a_hat, dtype=np.float64)
+    Qm = np.ascontiguousarray(Q, dtype=np.float64)
+    if a.ndim != 1 or a.size == 0:
+        raise AmbiguityInputError(f"a_hat{what}", f"shape {a.shape}; expected a non-empty vector (n,)")
+    if Qm.shape != (a.size, a.size):
+        raise AmbiguityInputError(f"Q{what}", f"shape {Qm.shape}; expected ({a.size}, {a.size}) to match a_hat")
+    if not np.all(np.isfinite(a)):
+        raise AmbiguityInputError(f"a_hat{what}", "contains NaN or infinity; expected finite float ambiguities")
+    return a, Qm
+
+
+def _checked_ltdl(Q):
+    code, i, j = check_matrix(Q)
+    raise_for_status(code, i, j)
+    n = Q.shape[0]
+    L, d = np.empty((n, n)), np.empty(n)
+    bad = ltdl_into(Q, L, d)
+    if bad >= 0:
+        raise_for_status(ERR_NOT_PD, bad, 0)
+    return L, d
+
+
+def ltdl(Q):
+    """LtDL factorisation ``Q = L^T diag(d) L`` of a symmetric positive-definite matrix (cycles^2).
+
+    Returns ``(L, d)``: ``L`` unit lower-triangular (n, n), ``d`` (n,) conditional variances (cycles^2).
+    """
+    Qm = np.ascontiguousarray(Q, dtype=np.float64)
+    if Qm.ndim != 2 or Qm.shape[0] != Qm.shape[1] or Qm.shape[0] == 0:
+        raise AmbiguityInputError("Q", f"shape {Qm.shape}; expected a square (n, n) matrix")
+    return _checked_ltdl(Qm)
+
+
+@dataclass(frozen=True)
+class Decorrelation:
+    """Result of :func:`decorrelate`: ``z = Z^T a``, ``Qz = Z^T Q Z = L^T diag(d) L``, ``a = Zti z``."""
+
+    Z: np.ndarray  # (n, n) int64, unimodular
+    Zti: np.ndarray  # (n, n) int64, inverse transpose of Z
+    Qz: np.ndarray  # (n, n) decorrelated covariance, cycles^2
+    L: np.ndarray  # (n, n) unit lower-triangular factor of Qz
+    d: np.ndarray  # (n,) conditional variances of z, cycles^2 (search starts at index n-1)
+    z_hat: np.ndarray | None  # (n,) Z^T a_hat when a_hat was given
+
+
+def decorrelate(Q, a_hat=None) -> Decorrelation:
+    """LAMBDA decorrelation of the ambiguity covariance ``Q`` (cycles^2), optionally transforming ``a_hat``."""
+    if a_hat is not None:
+        a, Qm = as_problem(a_hat, Q)
+    else:
+        Qm = np.ascontiguousarray(Q, dtype=np.float64)
+        if Qm.ndim != 2 or Qm.shape[0] != Qm.shape[1] or Qm.shape[0] == 0:
+            raise AmbiguityInputError("Q", f"shape {Qm.shape}; expected a square (n, n) matrix")
+        a = None
+    L, d = _checked_ltdl(Qm)
+    n = d.size
+    Z, Zti = np.eye(n, dtype=np.int64), np.eye(n, dtype=np.int64)
+    reduce_into(L, d, Z, Zti)
+    Qz = L.T @ (d[:, None] * L)
+    return Decorrelation(Z, Zti, Qz, L, d, None if a is None else Z.T.astype(np.float64) @ a)
