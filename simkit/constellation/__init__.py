@@ -1,1 +1,14 @@
-"""constellation"""
+"""GPS and BeiDou constellations: broadcast ephemerides (RINEX 3/4), YUMA/SEM almanacs, TLEs, nominal slots.
+
+``load(source)`` returns a :class:`Constellation` with ``.sat_ids``, ``.system``, ``.orbit_type`` and
+``.state(gps_week, gps_sow[, velocity=True])``; :mod:`.geometry` turns states into what a receiver sees
+(light time with Earth rotation, ranges, elevation/azimuth, mask, DOPs, visible counts). See docs/constellation.md.
+"""
+from .geometry import Geometry, dops, elevation_azimuth, receiver_view, visible_count
+from .model import Constellation, KeplerConstellation, Klobuchar
+from .sources import DEFAULT_SKY, bundled_files, load
+
+__all__ = [
+    "load", "bundled_files", "DEFAULT_SKY", "Constellation", "KeplerConstellation", "Klobuchar",
+    "receiver_view", "Geometry", "elevation_azimuth", "dops", "visible_count",
+]

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__, gpstime
+from ..earth import C_LIGHT
 from . import signals as sigmod
 
 _GPS_EPOCH = datetime(1980, 1, 6)
@@ -149,3 +150,32 @@ def copy_nav(sources, out_dir) -> list[Path]:
             shutil.copyfile(src, dst)
         out.append(dst)
     return out
+
+
+def export(gnss, start_week: int, start_sow: float, out_dir, nav_sources=(), name: str = "simkit") -> list[Path]:
+    """Write one RINEX 3.04 observation file per antenna, plus copies of the RINEX navigation sources.
+
+    ``gnss`` maps paths relative to /gnss to arrays (an open h5py group or the dict of
+    :meth:`GnssSimulator.process` outputs, values as arrays): needs ``t``, ``sat_id``, ``obs/<signal>/...``,
+    ``truth/receiver_clock`` (m, for the time tags) and ``truth/antenna_pos_ecef`` (approximate position).
+    ``nav_sources``: constellation sources; those that are files are copied (``nominal:`` ones have no file).
+    Returns the written paths (observation files first).
+    """
+    from ..constellation.sources import resolve
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    t = np.asarray(gnss["t"][...], dtype=float)
+    sat_ids = [s.decode() if isinstance(s, bytes) else str(s) for s in np.asarray(gnss["sat_id"][...])]
+    sig_names = [n for n in sigmod.SIGNALS if f"obs/{n}/code" in gnss]
+    clock = np.asarray(gnss["truth/receiver_clock"][...], dtype=float) / C_LIGHT
+    ant_pos = np.asarray(gnss["truth/antenna_pos_ecef"][0], dtype=float)
+    interval = float(np.median(np.diff(t))) if t.size > 1 else None
+    paths = []
+    for a in range(ant_pos.shape[0]):
+        obs = {n: {f: np.asarray(gnss[f"obs/{n}/{f}"][:, a, :]) for f in ("code", "carrier", "doppler", "cn0", "lli")}
+               for n in sig_names}
+        paths.append(write_obs(out_dir / f"{name}_ant{a}.rnx", start_week, start_sow, t, sat_ids, obs,
+                               ant_pos[a], clock[:, a], marker=f"{name.upper()}{a}", interval_s=interval))
+    files = [resolve(s) for s in nav_sources if not str(s).startswith("nominal:")]
+    return paths + copy_nav(files, out_dir)

@@ -44,7 +44,7 @@ def adev(y: np.ndarray, dt: float, taus=None, per_decade: int = 10):
     out = np.empty((m.size, y2.shape[1]))
     for i, mi in enumerate(m):
         d = x[2 * mi:] - 2.0 * x[mi:n + 1 - mi] + x[:n + 1 - 2 * mi]
-        out[i] = np.sqrt(np.einsum("ij,ij->j", d, d) / (d.shape[0] * 2.0 * (mi * dt) ** 2))
+        out[i] = np.sqrt(np.einsum("ij,ij->j", d, d) / (d.shape[0] * 2.0 * float(mi) ** 2))
     return m * dt, (out[:, 0] if flat else out), n + 1 - 2 * m
 
 

@@ -1,0 +1,144 @@
+"""What receivers see of a constellation: light time with Earth rotation, ranges, line of sight, elevation and
+azimuth, elevation mask, DOPs and visible counts. Vectorised over epochs (M) x satellites (S).
+
+Frames: satellite positions are returned in the ECEF frame *at reception time*: the position at emission time
+(ECEF of that instant) rotated about z by Omega_e * tau (Sagnac / Earth-rotation correction), tau the light time.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import frames, gpstime
+from ..earth import C_LIGHT, OMEGA_E
+from .model import Constellation
+
+LIGHT_TIME_ITERATIONS = 3  # each iteration shrinks the error by ~v_sat/c: 3 take 75 ms to < 1e-9 m
+
+
+@dataclass
+class Geometry:
+    """Receiver-satellite geometry at M reception epochs for S satellites (NaN where a satellite has no state).
+
+    ``tx_week`` (M, S) int and ``tx_sow`` (M, S) s: GPS emission time (reception minus geometric light time).
+    ``sat_pos`` (M, S, 3) m and ``sat_vel`` (M, S, 3) m/s (None unless asked): satellite at emission, in the ECEF
+    frame of reception. ``sat_clock`` (M, S) s and ``sat_drift`` (M, S) s/s at emission. ``range`` (M, S) m
+    geometric distance, ``tau`` (M, S) s light time, ``los`` (M, S, 3) unit vectors receiver -> satellite (ECEF),
+    ``elevation`` and ``azimuth`` (M, S) rad (azimuth clockwise from north in [0, 2 pi)).
+    """
+
+    tx_week: np.ndarray
+    tx_sow: np.ndarray
+    sat_pos: np.ndarray
+    sat_vel: np.ndarray | None
+    sat_clock: np.ndarray
+    sat_drift: np.ndarray | None
+    range: np.ndarray
+    tau: np.ndarray
+    los: np.ndarray
+    elevation: np.ndarray
+    azimuth: np.ndarray
+
+
+def _rotate_z(vec, angle):
+    """Rotate vectors (..., 3) by the frame rotation R_z(angle) (angle (...)): x' = c x + s y, y' = -s x + c y."""
+    c, s = np.cos(angle), np.sin(angle)
+    out = np.empty_like(vec)
+    out[..., 0] = c * vec[..., 0] + s * vec[..., 1]
+    out[..., 1] = -s * vec[..., 0] + c * vec[..., 1]
+    out[..., 2] = vec[..., 2]
+    return out
+
+
+def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: bool = False) -> Geometry:
+    """Emission times by light-time iteration with Earth rotation, for receivers at ``rx_pos`` (M, 3) m ECEF at
+    reception times (``gps_week`` scalar or (M,), ``gps_sow`` (M,) s GPS). Returns a :class:`Geometry`."""
+    rx = np.atleast_2d(np.asarray(rx_pos, dtype=float))
+    sow = np.atleast_1d(np.asarray(gps_sow, dtype=float))
+    week = np.broadcast_to(np.asarray(gps_week), sow.shape)
+    m, s = sow.size, len(const.sat_ids)
+    if rx.shape != (m, 3):
+        rx = np.broadcast_to(rx, (m, 3))
+    tau = np.full((m, s), 0.075)
+    week_ms = np.broadcast_to(week[:, None], (m, s))
+    for _ in range(LIGHT_TIME_ITERATIONS):
+        tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
+        pos = const.state_each(tw, ts)[0]
+        rot = _rotate_z(pos, OMEGA_E * tau)
+        tau = np.linalg.norm(rot - rx[:, None, :], axis=-1) / C_LIGHT
+    tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
+    out = const.state_each(tw, ts, velocity=velocity)
+    pos = _rotate_z(out[0], OMEGA_E * tau)
+    diff = pos - rx[:, None, :]
+    rng = np.linalg.norm(diff, axis=-1)
+    los = diff / rng[..., None]
+    el, az = elevation_azimuth(rx, los)
+    vel = _rotate_z(out[2], OMEGA_E * tau) if velocity else None
+    return Geometry(np.asarray(tw), np.asarray(ts), pos, vel, out[1], out[3] if velocity else None,
+                    rng, rng / C_LIGHT, los, el, az)
+
+
+def elevation_azimuth(rx_pos, los):
+    """Elevation and azimuth (rad) of unit line-of-sight vectors ``los`` (M, S, 3) ECEF seen from receivers at
+    ``rx_pos`` (M, 3) m ECEF (geodetic vertical, WGS-84). Azimuth clockwise from north in [0, 2 pi)."""
+    lla = frames.ecef_to_lla(np.atleast_2d(rx_pos))
+    c = frames.ecef_to_enu_matrix(lla[:, 0], lla[:, 1])  # (M, 3, 3)
+    enu = np.einsum("mij,msj->msi", c, los)
+    el = np.arcsin(np.clip(enu[..., 2], -1.0, 1.0))
+    az = np.mod(np.arctan2(enu[..., 0], enu[..., 1]), 2.0 * np.pi)
+    return el, az
+
+
+def visible(elevation, mask: float = 0.0):
+    """Boolean (M, S): satellite has a state and is at or above the elevation ``mask`` (rad)."""
+    el = np.asarray(elevation)
+    return np.isfinite(el) & (el >= mask)
+
+
+def visible_count(elevation, mask: float = 0.0):
+    """Number of satellites (M,) at or above the elevation ``mask`` (rad)."""
+    return visible(elevation, mask).sum(axis=-1)
+
+
+def dops(elevation, azimuth, mask: float = 0.0, system=None) -> dict[str, np.ndarray]:
+    """Dilutions of precision per epoch from elevation/azimuth (M, S) rad for satellites above ``mask`` (rad).
+
+    Unknowns: east, north, up and one receiver clock, or one clock per system when ``system`` ((S,) letters)
+    is given (a system with no visible satellite at an epoch then drops out). Returns {'G','P','H','V','T'}
+    -> (M,) arrays: GDOP = sqrt(trace Q), PDOP = sqrt(Qee+Qnn+Quu), HDOP = sqrt(Qee+Qnn), VDOP = sqrt(Quu),
+    TDOP = sqrt(Q of the first clock: the first system in sorted order). NaN with too few satellites.
+    """
+    el = np.asarray(elevation, dtype=float)
+    az = np.asarray(azimuth, dtype=float)
+    vis = visible(el, mask)
+    systems = np.unique(system) if system is not None else np.array(["*"])
+    sys_arr = np.asarray(system) if system is not None else np.full(el.shape[-1], "*")
+    k = 3 + systems.size
+    h = np.zeros(el.shape + (k,))
+    ce = np.cos(np.where(vis, el, 0.0))
+    h[..., 0] = -ce * np.sin(np.where(vis, az, 0.0))
+    h[..., 1] = -ce * np.cos(np.where(vis, az, 0.0))
+    h[..., 2] = -np.sin(np.where(vis, el, 0.0))
+    for j, code in enumerate(systems):
+        h[..., 3 + j] = sys_arr == code
+    h *= vis[..., None]
+    n = np.einsum("msi,msj->mij", h, h)
+    absent = np.einsum("mii->mi", n)[:, 3:] == 0
+    n[:, np.arange(3, k), np.arange(3, k)] += absent
+    unknowns = 3 + (~absent).sum(axis=-1)
+    ok = vis.sum(axis=-1) >= unknowns
+    n[~ok] = np.eye(k)
+    q = np.linalg.inv(n)
+    d = np.einsum("mii->mi", q)
+    clocks = np.where(absent, 0.0, d[:, 3:])
+    out = {
+        "G": np.sqrt(d[:, :3].sum(-1) + clocks.sum(-1)),
+        "P": np.sqrt(d[:, :3].sum(-1)),
+        "H": np.sqrt(d[:, :2].sum(-1)),
+        "V": np.sqrt(d[:, 2]),
+        "T": np.sqrt(np.where(absent[:, 0], np.nan, d[:, 3])),
+    }
+    for key in out:
+        out[key] = np.where(ok, out[key], np.nan)
+    return out

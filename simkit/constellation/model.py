@@ -1,0 +1,210 @@
+"""The constellation object returned by :func:`simkit.constellation.load`.
+
+:class:`Constellation` is the common interface (``sat_ids``, ``system``, ``orbit_type``, ``state``);
+:class:`KeplerConstellation` holds Keplerian records (broadcast ephemerides, almanacs, nominal slots) and picks,
+for every epoch and satellite, the healthy record with the nearest toe inside that record's validity.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import gpstime
+from . import kepler
+from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M, SYSTEMS
+
+SECONDS_PER_WEEK = gpstime.SECONDS_PER_WEEK
+
+
+@dataclass
+class Klobuchar:
+    """Broadcast Klobuchar coefficients: ``alpha`` (s, s/sc, s/sc^2, s/sc^3), ``beta`` (s, s/sc, ...)."""
+
+    alpha: np.ndarray
+    beta: np.ndarray
+
+
+@dataclass
+class GroupDelays:
+    """Broadcast group-delay parameters of one name (e.g. ``"TGD"``), one entry per broadcast record.
+
+    ``sat`` index into the constellation's ``sat_ids``, ``t`` GPS seconds since the reference week, ``value`` s.
+    """
+
+    sat: np.ndarray
+    t: np.ndarray
+    value: np.ndarray
+
+
+def orbit_types(sqrt_a, inclination) -> np.ndarray:
+    """'GEO', 'IGSO' or 'MEO' from the orbit: geosynchronous (a > 40,000 km) with i < 10 deg is GEO."""
+    a = np.asarray(sqrt_a, dtype=float) ** 2
+    inc = np.abs(np.asarray(inclination, dtype=float))
+    geosync = a > GEO_MIN_A_M
+    return np.where(geosync & (inc < GEO_MAX_INC_RAD), "GEO", np.where(geosync, "IGSO", "MEO"))
+
+
+class Constellation:
+    """A set of satellites whose states can be evaluated at GPS epochs.
+
+    Attributes: ``sat_ids`` (list of "G01"/"C03"), ``system`` (S,) array of 'G'/'C', ``orbit_type`` (S,)
+    array of 'MEO'/'IGSO'/'GEO', ``source`` (text), ``ref_week`` (GPS week that internal seconds count from),
+    ``klobuchar`` (dict 'G'/'C' -> :class:`Klobuchar`, only what the source broadcasts).
+    """
+
+    kind = "abstract"
+
+    def __init__(self, sat_ids, orbit_type, source: str, ref_week: int, klobuchar=None, group_delays=None):
+        self.sat_ids = list(sat_ids)
+        self.system = np.array([s[0] for s in self.sat_ids])
+        self.orbit_type = np.asarray(orbit_type)
+        self.source = source
+        self.ref_week = int(ref_week)
+        self.klobuchar = dict(klobuchar or {})
+        self._delays = dict(group_delays or {})
+
+    def __len__(self) -> int:
+        return len(self.sat_ids)
+
+    def __repr__(self) -> str:
+        kinds = {s: int(np.sum(self.system == s)) for s in np.unique(self.system)}
+        return f"<{type(self).__name__} {self.kind} {kinds} from {self.source}>"
+
+    def _seconds(self, gps_week, gps_sow):
+        """Broadcast (week, sow) -> (shape, float seconds since ``ref_week`` flattened)."""
+        week, sow = np.broadcast_arrays(np.asarray(gps_week), np.asarray(gps_sow, dtype=float))
+        t = (week.astype(np.int64) - self.ref_week) * SECONDS_PER_WEEK + sow
+        return week.shape, t.ravel()
+
+    def state(self, gps_week, gps_sow, velocity: bool = False):
+        """Satellite states at GPS times (transmit time), ECEF of that instant.
+
+        ``gps_week`` (int or array) and ``gps_sow`` (s, array) broadcast to a shape T. Returns ``pos`` (T + (S, 3))
+        m and ``clock`` (T + (S,)) s = af0 + af1 dt + af2 dt^2 + relativistic term, without group delays; with
+        ``velocity=True`` also ``vel`` (T + (S, 3)) m/s (ECEF, rotating frame) and ``drift`` (T + (S,)) s/s.
+        NaN where no record is valid at that epoch.
+        """
+        shape, t = self._seconds(gps_week, gps_sow)
+        s = len(self.sat_ids)
+        return self._shaped(self._evaluate(np.broadcast_to(t[:, None], (t.size, s)), velocity), shape)
+
+    def state_each(self, gps_week, gps_sow, velocity: bool = False):
+        """Like :meth:`state`, but satellite s is evaluated at its own time: ``gps_week``/``gps_sow`` broadcast
+        to a shape T + (S,) (e.g. per-satellite transmit times). Same returns as :meth:`state`."""
+        shape, t = self._seconds(gps_week, gps_sow)
+        s = len(self.sat_ids)
+        if not shape or shape[-1] != s:
+            raise ValueError(f"state_each needs times of shape (..., {s}), got {shape}")
+        return self._shaped(self._evaluate(t.reshape(-1, s), velocity), shape[:-1])
+
+    def _shaped(self, out, shape):
+        s = len(self.sat_ids)
+        dims = (shape + (s, 3), shape + (s,), shape + (s, 3), shape + (s,))
+        return tuple(a.reshape(d) for a, d in zip(out, dims))  # 2 or 4 arrays
+
+    def _evaluate(self, t, velocity):
+        """States at times ``t`` (N, S) (GPS s since ref_week; column s for satellite s) -> flat arrays."""
+        raise NotImplementedError
+
+    def group_delay_names(self) -> list[str]:
+        """Names of the broadcast group delays this source carries (e.g. TGD, TGD1, TGD2, TGD_B1Cp)."""
+        return sorted(self._delays)
+
+    def group_delays(self, gps_week=None, gps_sow=None) -> dict[str, np.ndarray]:
+        """Broadcast group delays per satellite: name -> (S,) seconds, NaN where a satellite has none.
+
+        Each value comes from that satellite's broadcast record nearest to (gps_week, gps_sow) (default: the
+        middle of the records' span). GPS: ``TGD``; BDS D1/D2: ``TGD1`` (B1I), ``TGD2`` (B2I); BDS CNAV1/2
+        (RINEX 4): ``TGD_B1Cp``, ``TGD_B2ap``, ``ISC_B1Cd``, ``ISC_B2ad``.
+        """
+        out = {}
+        for name, d in self._delays.items():
+            if gps_week is None:
+                t0 = 0.5 * (d.t.min() + d.t.max())
+            else:
+                t0 = float(self._seconds(gps_week, gps_sow)[1][0])
+            vals = np.full(len(self.sat_ids), np.nan)
+            order = np.lexsort((np.abs(d.t - t0), d.sat))
+            first = np.unique(d.sat[order], return_index=True)[1]
+            vals[d.sat[order][first]] = d.value[order][first]
+            out[name] = vals
+        return out
+
+
+@dataclass
+class Records:
+    """Keplerian records: ``params`` (R, len(kepler.FIELDS)), ``sat`` (R,) index, ``healthy`` (R,) bool,
+    ``half_width`` (R,) s validity either side of toe (np.inf: always valid), ``period`` (R,) s or None: a
+    record repeats with this period (10-bit almanac weeks: 1024 weeks) and each query uses its nearest copy."""
+
+    params: np.ndarray
+    sat: np.ndarray
+    healthy: np.ndarray
+    half_width: np.ndarray
+    period: np.ndarray | None = None
+
+
+class KeplerConstellation(Constellation):
+    """Constellation of Keplerian records (broadcast ephemeris, almanac or nominal slots)."""
+
+    def __init__(self, sat_ids, records: Records, source: str, ref_week: int, kind: str,
+                 klobuchar=None, group_delays=None):
+        p = records.params
+        # orbit type from each satellite's first healthy record (or any record)
+        otype = []
+        for s in range(len(sat_ids)):
+            rows = np.flatnonzero((records.sat == s) & records.healthy)
+            rows = rows if rows.size else np.flatnonzero(records.sat == s)
+            r = rows[0]
+            otype.append(orbit_types(p[r, kepler.COL["sqrt_a"]], p[r, kepler.COL["i0"]]).item())
+        super().__init__(sat_ids, otype, source, ref_week, klobuchar, group_delays)
+        self.kind = kind
+        self.records = records
+        toe = p[:, kepler.COL["toe"]]
+        period = records.period if records.period is not None else np.full(len(toe), np.inf)
+        self._sel = []
+        for s in range(len(sat_ids)):
+            rows = np.flatnonzero((records.sat == s) & records.healthy)
+            rows = rows[np.argsort(toe[rows], kind="stable")]
+            per = np.unique(period[rows])
+            if per.size > 1:
+                raise ValueError(f"{sat_ids[s]}: records with different repeat periods")
+            self._sel.append((rows, toe[rows], records.half_width[rows], per[0] if per.size else np.inf))
+
+    def select(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Record index (N, S) for times ``t`` (N, S) (GPS s since ``ref_week``, column s for satellite s): the
+        healthy record with the nearest toe (the later one on a tie) whose validity covers t; -1 where none.
+        Also returns the times to evaluate at (``t`` moved by whole periods for repeating almanac records)."""
+        idx = np.full(t.shape, -1, dtype=np.int64)
+        t_eval = np.array(t, dtype=float)
+        for s, (rows, toe, half, period) in enumerate(self._sel):
+            if rows.size == 0:
+                continue
+            ts = t_eval[:, s]  # a view: shifting it shifts t_eval
+            if np.isfinite(period):
+                ts -= period * np.round((ts - toe[0]) / period)
+            j = np.searchsorted(toe, ts, side="right")  # toe[j-1] <= t < toe[j]
+            lo = np.clip(j - 1, 0, rows.size - 1)
+            hi = np.clip(j, 0, rows.size - 1)
+            pick = np.where(np.abs(toe[hi] - ts) <= np.abs(ts - toe[lo]), hi, lo)
+            ok = np.abs(ts - toe[pick]) <= half[pick]
+            idx[:, s] = np.where(ok, rows[pick], -1)
+        return idx, t_eval
+
+    def _evaluate(self, t, velocity):
+        idx, t_eval = self.select(t)
+        return kepler.propagate(self.records.params, idx.ravel(), t_eval.ravel(), velocity)
+
+    def orbit_params(self, gps_week, gps_sow) -> tuple[np.ndarray, np.ndarray]:
+        """The record (row of ``records.params``, columns ``kepler.FIELDS``) used per epoch and satellite:
+        returns (idx (T + (S,)) int, -1 where none; params table)."""
+        shape, t = self._seconds(gps_week, gps_sow)
+        s = len(self.sat_ids)
+        idx = self.select(np.broadcast_to(t[:, None], (t.size, s)))[0]
+        return idx.reshape(shape + (s,)), self.records.params
+
+
+def system_of(sat_id: str):
+    """The :class:`~simkit.constellation.systems.System` of a satellite id ("G05" -> GPS)."""
+    return SYSTEMS[sat_id[0]]

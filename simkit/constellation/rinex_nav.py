@@ -1,0 +1,231 @@
+"""RINEX 3.0x / 4.00 navigation files -> broadcast ephemeris constellation (GPS LNAV, BDS D1/D2).
+
+Mixed multi-GNSS files are accepted; only GPS and BDS Keplerian records are kept (other systems are skipped).
+Satellite ids may be written "C03" or "C 3". RINEX 4 ``> EPH`` records of type LNAV (GPS) and D1/D2 (BDS) are
+used for orbits; BDS CNV1/CNV2 records are read only for their group delays (TGD_B1Cp, TGD_B2ap, ISC_B1Cd,
+ISC_B2ad); GPS CNAV/CNV2 and BDS CNV3 records are skipped. Klobuchar coefficients come from the RINEX 3 header
+(GPSA/GPSB, BDSA/BDSB) or the first RINEX 4 ``> ION`` record of each system (G LNAV, C D1D2).
+
+Time conventions of the file: GPS epochs and toe in GPST; BDS epochs, toe and week in BDT (converted here to
+GPS-time seconds with BDT = GPST - 14 s, week + 1356). As in RTKLIB, a toe whose week disagrees with toc by
+more than half a week is moved by one week.
+"""
+from __future__ import annotations
+
+from datetime import date
+
+import numpy as np
+
+from ..errors import DataFileError
+from . import kepler
+from .model import GroupDelays, KeplerConstellation, Klobuchar, Records
+from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M, SYSTEMS
+from .textfile import number, read_lines
+
+N_FIELDS = 31  # af0 af1 af2 + 7 lines x 4 broadcast-orbit values
+_GPS_DAY0 = date(1980, 1, 6).toordinal()
+# positions within the 31 values (RINEX 3.04 Tables A6 and A14; RINEX 4.00 LNAV/D1/D2 are identical)
+AF0, AF1, AF2, IODE, CRS, DN, M0, CUC, E, CUS, SQRTA, TOE, CIC, OMEGA0, CIS, I0, CRC, OMEGA, OMEGADOT, IDOT, \
+    CODES, WEEK, L2P, ACC, HEALTH, TGD1, TGD2 = range(27)
+_REQUIRED = {SQRTA: "sqrt(A)", E: "eccentricity", I0: "i0", OMEGA0: "OMEGA0", TOE: "toe", WEEK: "week", M0: "M0"}
+_CNV_DELAYS = {"CNV1": {24: "ISC_B1Cd", 26: "TGD_B1Cp", 27: "TGD_B2ap"},
+               "CNV2": {25: "ISC_B2ad", 26: "TGD_B1Cp", 27: "TGD_B2ap"}}
+
+
+def is_rinex_nav(lines: list[str]) -> bool:
+    """True when the first line is a RINEX navigation 'RINEX VERSION / TYPE' header."""
+    return bool(lines) and "RINEX VERSION / TYPE" in lines[0] and lines[0][20:21] == "N"
+
+
+def _sat_id(text: str) -> str:
+    """'C 3' / 'C03' / 'G 5' -> 'C03' / 'G05'."""
+    return f"{text[0]}{int(text[1:3]):02d}"
+
+
+def _epoch_seconds(text: str, path, line: int) -> float:
+    """'2026 04 27 00 00 00' -> seconds since 1980-01-06 00:00 in the same time scale (calendar arithmetic)."""
+    try:
+        y, mo, d, h, mi = (int(v) for v in text[:16].split())
+        sec = float(text[16:19])
+        day = date(y, mo, d).toordinal() - _GPS_DAY0
+    except ValueError:
+        raise DataFileError(path, f"bad epoch {text.strip()!r}: expected 'YYYY MM DD hh mm ss'", line) from None
+    return day * 86400.0 + h * 3600.0 + mi * 60.0 + sec
+
+
+def _values(block: list[str], path, first_line: int) -> np.ndarray:
+    """The 31 numbers of one GPS/BDS record: af0..af2 from the epoch line, 4 per broadcast-orbit line."""
+    vals = np.zeros(N_FIELDS)
+    epoch = block[0]
+    for k in range(3):
+        vals[k] = number(epoch[23 + 19 * k: 42 + 19 * k], path, first_line, f"clock term {k}")
+    for j, line in enumerate(block[1:8]):
+        if line[:4].strip():
+            raise DataFileError(path, "record is truncated: expected a broadcast-orbit line", first_line + 1 + j)
+        for k in range(4):
+            f = 3 + 4 * j + k
+            vals[f] = number(line[4 + 19 * k: 23 + 19 * k], path, first_line + 1 + j, f"orbit value {f - 2}",
+                             blank=None if f in _REQUIRED else 0.0)
+    return vals
+
+
+def _header(lines, path):
+    """-> (index of the first data line, version, klobuchar dict)."""
+    if not is_rinex_nav(lines):
+        raise DataFileError(path, "not a RINEX navigation file (no 'RINEX VERSION / TYPE' with type N)", 1)
+    version = number(lines[0][:9], path, 1, "RINEX version", blank=None)
+    if not 3.0 <= version < 5.0:
+        raise DataFileError(path, f"RINEX navigation version {version} is not supported (3.0x or 4.0x)", 1)
+    klob = {}
+    for i, line in enumerate(lines):
+        label = line[60:].strip()
+        if label == "END OF HEADER":
+            return i + 1, version, klob
+        if label == "IONOSPHERIC CORR" and line[:4] in ("GPSA", "GPSB", "BDSA", "BDSB"):
+            vals = np.array([number(line[5 + 12 * k: 17 + 12 * k], path, i + 1, "ionospheric coefficient")
+                             for k in range(4)])
+            sys = "G" if line[:3] == "GPS" else "C"
+            entry = klob.setdefault(sys, Klobuchar(np.full(4, np.nan), np.full(4, np.nan)))
+            setattr(entry, "alpha" if line[3] == "A" else "beta", vals)
+    raise DataFileError(path, "no 'END OF HEADER' line: truncated header", len(lines))
+
+
+def _rinex3_blocks(lines, start, path):
+    """Yield (first line number, kind, block lines) for every GPS/BDS record of a RINEX 3 body."""
+    n = len(lines)
+    i = start
+    while i < n:
+        line = lines[i]
+        if not line.strip():
+            i += 1
+            continue
+        if line[0] == " ":
+            raise DataFileError(path, "expected a record start (satellite id in column 1)", i + 1)
+        j = i + 1
+        while j < n and (not lines[j] or lines[j][0] == " "):
+            j += 1
+        if line[0] in "GC":
+            yield i + 1, "", lines[i:j]
+        i = j
+
+
+def _rinex4_blocks(lines, start, path):
+    """Yield (first line number, kind, block lines) for every RINEX 4 record (EPH, ION, ...)."""
+    n = len(lines)
+    i = start
+    while i < n:
+        line = lines[i]
+        if not line.strip():
+            i += 1
+            continue
+        if line[0] != ">":
+            raise DataFileError(path, "expected a RINEX 4 record header starting with '>'", i + 1)
+        j = i + 1
+        while j < n and not lines[j].startswith(">"):
+            j += 1
+        yield i + 1, line, lines[i + 1:j]
+        i = j
+
+
+def read(path) -> KeplerConstellation:
+    """Parse a RINEX 3.0x/4.00 navigation file (plain or gzip) into a broadcast-ephemeris constellation."""
+    lines = read_lines(path)
+    start, version, klob = _header(lines, path)
+    ids, vals, delays = [], [], []
+    if version < 4.0:
+        for ln, _, block in _rinex3_blocks(lines, start, path):
+            _check_len(block, ln, path)
+            ids.append(_sat_id(block[0][:3]))
+            vals.append(np.append(_values(block, path, ln), _epoch_seconds(block[0][4:23], path, ln)))
+    else:
+        for ln, head, block in _rinex4_blocks(lines, start, path):
+            parts = head[1:].split()
+            if len(parts) < 3:
+                raise DataFileError(path, "record header should read '> TYPE SAT MESSAGE'", ln)
+            rtype, sat, msg = parts[0], parts[1], parts[2]
+            if sat[0] not in "GC":
+                continue
+            if rtype == "ION" and sat[0] not in klob and (msg, sat[0]) in (("LNAV", "G"), ("D1D2", "C")):
+                klob[sat[0]] = _ion4(block, path, ln + 1)
+            elif rtype == "EPH" and msg in ("LNAV", "D1", "D2"):
+                _check_len(block, ln + 1, path)
+                ids.append(_sat_id(block[0][:3]))
+                vals.append(np.append(_values(block, path, ln + 1),
+                                      _epoch_seconds(block[0][4:23], path, ln + 1)))
+            elif rtype == "EPH" and msg in _CNV_DELAYS and sat[0] == "C":
+                if len(block) < 8:
+                    raise DataFileError(path, f"{msg} record is truncated", ln + len(block))
+                row = [number(block[7][4 + 19 * k: 23 + 19 * k], path, ln + 8, "group delay", blank=np.nan)
+                       for k in range(4)]
+                t = _epoch_seconds(block[0][4:23], path, ln + 1)
+                delays.extend((name, _sat_id(block[0][:3]), t, row[f - 24])
+                              for f, name in _CNV_DELAYS[msg].items())
+    if not ids:
+        raise DataFileError(path, "no GPS or BDS broadcast ephemeris records found")
+    return build(ids, np.array(vals), str(path), klob, delays, path)
+
+
+def _check_len(block, ln, path):
+    if len(block) != 8:
+        raise DataFileError(path, f"record for {block[0][:3].strip()} has {len(block)} lines, expected 8 "
+                            "(truncated or malformed)", ln + len(block) - 1)
+
+
+def _ion4(block, path, ln) -> Klobuchar:
+    vals = []
+    for j, line in enumerate(block[:3]):
+        lo = 23 if j == 0 else 4
+        for k in range(3 if j == 0 else 4):
+            vals.append(number(line[lo + 19 * k: lo + 19 + 19 * k], path, ln + j, "Klobuchar coefficient",
+                               blank=np.nan))
+    if len(vals) < 8:
+        raise DataFileError(path, "ION record is truncated: expected 8 Klobuchar coefficients", ln)
+    return Klobuchar(np.array(vals[:4]), np.array(vals[4:8]))
+
+
+def build(ids, vals, source, klob, cnav_delays, path) -> KeplerConstellation:
+    """Records (one row of 31 RINEX values + toc calendar seconds per record) -> KeplerConstellation."""
+    ids = np.array(ids)
+    sat_ids = sorted(set(ids.tolist()))
+    sat = np.searchsorted(sat_ids, ids)
+    is_bds = np.char.startswith(ids, "C")
+    offs = np.where(is_bds, SYSTEMS["C"].time_offset_s, 0.0)
+    week_off = np.where(is_bds, SYSTEMS["C"].week_offset, 0)
+    toc_abs = vals[:, N_FIELDS] + offs
+    toe_abs = (vals[:, WEEK] + week_off) * 604800.0 + vals[:, TOE] + offs
+    toe_abs += 604800.0 * np.round((toc_abs - toe_abs) / 604800.0)
+    ref_week = int(np.floor(toe_abs.min() / 604800.0))
+    t0 = ref_week * 604800.0
+    n = len(ids)
+    p = kepler.empty_table(n)
+    c = kepler.COL
+    p[:, c["toe"]] = toe_abs - t0
+    p[:, c["toc"]] = toc_abs - t0
+    for name, f in (("sqrt_a", SQRTA), ("e", E), ("i0", I0), ("omega0", OMEGA0), ("omega", OMEGA), ("m0", M0),
+                    ("delta_n", DN), ("idot", IDOT), ("omega_dot", OMEGADOT), ("cuc", CUC), ("cus", CUS),
+                    ("crc", CRC), ("crs", CRS), ("cic", CIC), ("cis", CIS), ("af0", AF0), ("af1", AF1),
+                    ("af2", AF2), ("toe_sow", TOE)):
+        p[:, c[name]] = vals[:, f]
+    for code, system in SYSTEMS.items():
+        m = ids.astype("<U1") == code
+        p[m, c["mu"]] = system.mu
+        p[m, c["omega_e"]] = system.omega_e
+        p[m, c["rel_f"]] = system.rel_f
+    bad = (vals[:, SQRTA] <= 0) | (vals[:, E] < 0) | (vals[:, E] >= 1)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise DataFileError(path, f"record {k + 1} ({ids[k]}): sqrt(A) must be > 0 and 0 <= e < 1")
+    p[:, c["geo"]] = is_bds & (vals[:, SQRTA] ** 2 > GEO_MIN_A_M) & (np.abs(vals[:, I0]) < GEO_MAX_INC_RAD)
+    half = np.where(is_bds, SYSTEMS["C"].fit_half_s, SYSTEMS["G"].fit_half_s)
+    records = Records(p, sat, vals[:, HEALTH] == 0, half)
+    delays = {}
+    for name, f, m in (("TGD", TGD1, ~is_bds), ("TGD1", TGD1, is_bds), ("TGD2", TGD2, is_bds)):
+        if m.any():
+            delays[name] = GroupDelays(sat[m], p[m, c["toe"]], vals[m, f])
+    for name in sorted({d[0] for d in cnav_delays}):
+        rows = [d for d in cnav_delays if d[0] == name and d[1] in sat_ids]
+        if rows:
+            delays[name] = GroupDelays(np.searchsorted(sat_ids, [r[1] for r in rows]),
+                                       np.array([r[2] for r in rows]) + SYSTEMS["C"].time_offset_s - t0,
+                                       np.array([r[3] for r in rows]))
+    return KeplerConstellation(sat_ids, records, source, ref_week, "broadcast", klob, delays)

@@ -1,0 +1,205 @@
+"""Loading a scenario: TOML (tomllib) or a dict, ``--set`` overrides, validation into one :class:`Scenario`.
+
+The top-level tables are ``[scenario]``, ``[trajectory]``, ``[imu]`` and ``[gnss]``; each stage validates its own
+table. Every error is a :class:`ScenarioError` naming the file and the dotted key path.
+"""
+from __future__ import annotations
+
+import copy
+import re
+import tomllib
+from dataclasses import dataclass, field
+from datetime import datetime
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from .. import gpstime
+from ..errors import ScenarioError
+from .fields import Section, positive
+
+_INDEX = re.compile(r"^([A-Za-z_][\w-]*)(?:\[(\d+)\])?$")
+
+
+def bundled_dir() -> Path:
+    """The folder of scenarios shipped inside the package."""
+    return Path(str(resources.files("simkit") / "scenarios"))
+
+
+def bundled_names() -> list[str]:
+    return sorted(p.stem for p in bundled_dir().glob("*.toml"))
+
+
+def resolve(path_or_name: str | Path) -> Path:
+    """A scenario file path, or the bundled scenario of that name (``quickstart`` or ``quickstart.toml``)."""
+    p = Path(path_or_name)
+    if p.is_file():
+        return p
+    candidate = bundled_dir() / (p.name if p.suffix == ".toml" else p.name + ".toml")
+    if candidate.is_file() and (len(p.parts) == 1 or p.parent.name == "scenarios"):
+        return candidate
+    raise ScenarioError("", f"no such scenario file (bundled scenarios: {', '.join(bundled_names())})", str(p))
+
+
+@dataclass
+class Scenario:
+    """A validated scenario. Times: ``start_week``/``start_sow`` in GPS time; ``duration_s`` in seconds."""
+
+    name: str
+    description: str
+    start: datetime
+    start_week: int
+    start_sow: float
+    duration_s: float
+    seed: int
+    text: str
+    source: str
+    data: dict
+    trajectory: Any
+    imu: Any = None
+    gnss: Any = None
+    overrides: list = field(default_factory=list)
+
+
+def parse_value(text: str):
+    """A ``--set`` value: a TOML literal (number, bool, string, array, inline table) or else a bare string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_override(data: dict, assignment: str) -> None:
+    """Apply ``dotted.key[i].path=value`` to the scenario dict in place."""
+    if "=" not in assignment:
+        raise ScenarioError("--set", f"expected dotted.key=value, got {assignment!r}")
+    key, text = assignment.split("=", 1)
+    parts = key.strip().split(".")
+    node: Any = data
+    for depth, part in enumerate(parts):
+        m = _INDEX.match(part)
+        if not m:
+            raise ScenarioError(key, f"--set: malformed key part {part!r}")
+        name, index = m.group(1), m.group(2)
+        last = depth == len(parts) - 1
+        if index is not None:
+            items = node.get(name)
+            if not isinstance(items, list) or int(index) >= len(items):
+                n = len(items) if isinstance(items, list) else 0
+                raise ScenarioError(key, f"--set: {name} has {n} entries, no index {index}")
+            if last:
+                items[int(index)] = parse_value(text)
+            node = items[int(index)]
+        elif last:
+            node[name] = parse_value(text)
+        else:
+            node = node.setdefault(name, {})
+            if not isinstance(node, dict):
+                raise ScenarioError(key, f"--set: {name} is not a table")
+
+
+def load(scenario: str | Path | dict, overrides: list[str] | None = None) -> Scenario:
+    """Read, override and validate a scenario (a TOML path, a bundled name, or a dict)."""
+    overrides = list(overrides or [])
+    if isinstance(scenario, dict):
+        data, text, source = copy.deepcopy(scenario), None, "<dict>"
+    else:
+        path = resolve(scenario)
+        source = str(scenario)
+        try:
+            text = path.read_text(encoding="utf-8")
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ScenarioError("", f"not valid TOML: {exc}", source) from None
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ScenarioError("", f"cannot read: {exc}", source) from None
+    try:
+        for item in overrides:
+            apply_override(data, item)
+        sc = _validate(data)
+    except ScenarioError as exc:
+        raise exc.with_source(source) from None
+    sc.source = source
+    sc.text = text if text is not None else _to_toml(data)
+    if overrides and text is not None:
+        sc.text += "\n# overrides applied on top of the text above:\n" + "".join(f"# --set {o}\n" for o in overrides)
+    sc.overrides = overrides
+    return sc
+
+
+def _validate(data: dict) -> Scenario:
+    root = Section(data, "")
+    meta = root.section("scenario", required=True)
+    name = meta.get("name", str, check=lambda v: None if re.fullmatch(r"[\w.-]+", v) else
+                    "must be letters, digits, '_', '-' or '.'")
+    description = meta.get("description", str, "")
+    start_text = meta.get("start", str)
+    try:
+        start = gpstime.parse_utc(start_text)
+    except ValueError:
+        raise meta.error("start", f"expected a UTC ISO 8601 time like 2016-11-08T00:00:00Z, got {start_text!r}")
+    duration = meta.get("duration_s", float, check=positive)
+    seed = meta.get("seed", int, 0, check=lambda v: None if v >= 0 else "must be >= 0")
+    meta.done()
+    week, sow = gpstime.utc_to_gps(start)
+
+    from ..trajectory import parse_config as parse_trajectory
+
+    traj = parse_trajectory(root.section("trajectory", required=True))
+    imu = gnss = None
+    if root.has("imu"):
+        from ..imu import parse_config as parse_imu
+
+        imu = parse_imu(root.section("imu"))
+        rate = getattr(imu, "rate_hz", None)
+        if rate is not None and abs(rate - traj.rate_hz) > 1e-9:
+            raise ScenarioError("imu.rate_hz", f"must equal trajectory.rate_hz ({traj.rate_hz:g}): the truth is "
+                                f"generated at the IMU rate, got {rate:g}")
+    if root.has("gnss"):
+        from ..gnss import parse_config as parse_gnss
+
+        gnss = parse_gnss(root.section("gnss"))
+        ratio = traj.rate_hz / gnss.rate_hz
+        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+            raise ScenarioError("gnss.rate_hz", f"must divide trajectory.rate_hz ({traj.rate_hz:g}) into a whole "
+                                f"number of samples, got {gnss.rate_hz:g}")
+    root.done()
+    return Scenario(name=name, description=description, start=start, start_week=week, start_sow=sow,
+                    duration_s=duration, seed=seed, text="", source="", data=data, trajectory=traj, imu=imu,
+                    gnss=gnss)
+
+
+def _to_toml(data: dict) -> str:
+    """A TOML rendering of a scenario dict (for provenance of scenarios given as dicts)."""
+    lines: list[str] = []
+
+    def scalar(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, str):
+            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        if isinstance(v, dict):
+            return "{" + ", ".join(f"{k} = {scalar(x)}" for k, x in v.items()) + "}"
+        if isinstance(v, list):
+            return "[" + ", ".join(scalar(x) for x in v) + "]"
+        return repr(v)
+
+    def table(prefix, d):
+        simple = {k: v for k, v in d.items() if not isinstance(v, dict) and not (
+            isinstance(v, list) and v and all(isinstance(i, dict) for i in v))}
+        for k, v in simple.items():
+            lines.append(f"{k} = {scalar(v)}")
+        for k, v in d.items():
+            if k in simple:
+                continue
+            name = f"{prefix}.{k}" if prefix else k
+            if isinstance(v, dict):
+                lines.append(f"\n[{name}]")
+                table(name, v)
+            else:
+                for item in v:
+                    lines.append(f"\n[[{name}]]")
+                    table(name, item)
+
+    table("", data)
+    return "\n".join(lines).lstrip() + "\n"
