@@ -77,7 +77,7 @@ def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, ap
     now = datetime.now(timezone.utc).strftime("%Y%m%d %H%M%S UTC")
     head = _hdr(f"{'3.04':>9}{'':11}{'OBSERVATION DATA':<20}{mixed:<20}", "RINEX VERSION / TYPE")
     head += _hdr(f"{'simkit ' + __version__:<20}{'simkit':<20}{now:<20}", "PGM / RUN BY / DATE")
-    head += _hdr("simulated by simkit: time tags are receiver time (true GPS time + clock bias)", "COMMENT")
+    head += _hdr("simkit: time tags = true GPS time + receiver clock bias", "COMMENT")
     head += _hdr(marker, "MARKER NAME")
     head += _hdr("GEODETIC", "MARKER TYPE")
     head += _hdr(f"{'simkit':<20}{'simkit':<40}", "OBSERVER / AGENCY")
