@@ -34,8 +34,7 @@ def _rtklib_nav(src: Path, tmp_path: Path):
 def _sat_id(sat):
     buf = pyrtklib.Arr1Dchar(8)
     pyrtklib.satno2id(sat, buf)
-    chars = [chr(buf[i]) if isinstance(buf[i], int) else buf[i] for i in range(8)]
-    return "".join(chars).split("\x00")[0]
+    return buf[0]  # element 0 reads the C string up to its NUL
 
 
 @pytest.mark.parametrize("name", FILES)
@@ -74,7 +73,7 @@ def test_eph2pos_agreement(name, tmp_path):
     kinds = np.array(kinds)
     for kind in np.unique(kinds):
         m = kinds == kind
-        print(f"{name} {kind}: {m.sum()} evaluations, max |dpos| {dpos[m].max() * 1e3:.4f} mm, "
+        print(f"{name} {kind}: {m.sum()} evaluations, max |dpos| {dpos[m].max():.2e} m, "
               f"max |dclk| {dclk[m].max():.2e} s")
     assert dpos.max() < 1e-3
     assert dclk.max() < 1e-12
