@@ -91,6 +91,7 @@ def parse_config(sec: Section) -> TrajectoryConfig:
     ramp = sec.get("ramp_s", float, 1.0, check=positive)
     state = KinematicState(speed, gamma, heading)
     items, planned = plan(sec.sections("segment"), state, ramp)
+    sec.done()
     return TrajectoryConfig(rate, lat, lon, height, speed, gamma, heading, roll, coordinated, items, planned)
 
 
