@@ -32,17 +32,22 @@ def truth_increments(x: np.ndarray, prev: np.ndarray | None, dt: float) -> np.nd
     """Integral of the sampled truth over each interval (t[k-1], t[k]].
 
     Exact integration of the quadratic through the samples k-2, k-1, k: dt (-x[k-2] + 8 x[k-1] + 5 x[k]) / 12;
-    the trapezoid for the second sample and dt x[0] (constant extrapolation) for the very first. ``prev`` holds
-    the last two samples of the previous block (None at the start).
+    the trapezoid for the second sample of the record and dt x[0] (constant extrapolation) for the very first.
+    ``prev`` holds the last (up to two) samples before this block (None or empty at the start of the record).
     """
-    if prev is None:
-        head = np.concatenate([x[:1], x[:1], x])           # x[-2] = x[-1] = x[0]
-        out = dt * (-head[:-2] + 8.0 * head[1:-1] + 5.0 * head[2:]) / 12.0
-        if x.shape[0] > 1:
-            out[1] = dt * 0.5 * (x[0] + x[1])
-        return out
-    head = np.concatenate([prev, x])
-    return dt * (-head[:-2] + 8.0 * head[1:-1] + 5.0 * head[2:]) / 12.0
+    hist = x[:0] if prev is None else prev
+    lag, n = hist.shape[0], x.shape[0]
+    head = np.concatenate([hist, x])               # output j uses head[lag + j - 2 : lag + j + 1]
+    out = np.empty_like(x)
+    j0 = min(max(0, 2 - lag), n)                   # first output with two samples before it
+    out[j0:] = dt * (-head[lag + j0 - 2:lag + n - 2] + 8.0 * head[lag + j0 - 1:lag + n - 1]
+                     + 5.0 * head[lag + j0:]) / 12.0
+    if lag == 0 and n > 0:
+        out[0] = dt * x[0]
+    if lag <= 1 and n > 1 - lag:
+        j = 1 - lag
+        out[j] = dt * 0.5 * (head[lag + j - 1] + head[lag + j])
+    return out
 
 
 def _apply(matrix: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -118,7 +123,7 @@ class _Sensor:
         increments = None
         if self.increments:
             true_inc = truth_increments(x, self.prev, self.dt)
-            self.prev = np.concatenate([self.prev if self.prev is not None else x[:1], x])[-2:].copy()
+            self.prev = np.concatenate([self.prev if self.prev is not None else x[:0], x])[-2:].copy()
             raw = true_inc + self.dt * (y - x)
             increments = self.quantizer.block(raw) if self.quantizer is not None else raw
             out = increments / self.dt
