@@ -56,11 +56,18 @@ def enu_to_ecef_vec(vec, lat, lon):
     return np.einsum("...ji,...j->...i", ecef_to_enu_matrix(lat, lon), vec)
 
 
+def quat_from_euler(pitch, roll, heading) -> np.ndarray:
+    """Scalar-last quaternions (..., 4) of C_b^n = R_z(-heading) R_x(pitch) R_y(roll), in closed form
+    (the product q_z q_x q_y written out; several times faster than a generic Euler conversion)."""
+    p2, r2, y2 = np.asarray(pitch, float) / 2, np.asarray(roll, float) / 2, -np.asarray(heading, float) / 2
+    sx, cx, sy, cy, sz, cz = np.sin(p2), np.cos(p2), np.sin(r2), np.cos(r2), np.sin(y2), np.cos(y2)
+    ax, ay, az, aw = cz * sx, sz * sx, sz * cx, cz * cx  # q_z q_x
+    return np.stack([ax * cy - az * sy, aw * sy + ay * cy, ax * sy + az * cy, aw * cy - ay * sy], axis=-1)
+
+
 def attitude_from_euler(pitch, roll, heading) -> Rotation:
     """Body -> ENU rotation(s) from pitch, roll, heading (rad)."""
-    yaw = -np.asarray(heading, dtype=float)
-    angles = np.stack(np.broadcast_arrays(yaw, np.asarray(pitch, float), np.asarray(roll, float)), axis=-1)
-    return Rotation.from_euler("ZXY", angles)
+    return Rotation.from_quat(quat_from_euler(pitch, roll, heading))
 
 
 def euler_from_attitude(rot: Rotation) -> np.ndarray:

@@ -198,7 +198,7 @@ class Trajectory:
                    + (speed * gamma_dot)[:, None] * np.stack([-sg * sp, -sg * cp, cg], -1)
                    + (speed * psi_dot)[:, None] * np.stack([cg * cp, -cg * sp, np.zeros_like(t)], -1))
 
-        rot = Rotation.from_euler("ZXY", np.stack([-psi, gamma, roll], axis=-1))
+        rot = Rotation.from_quat(frames.quat_from_euler(gamma, roll, psi))
         # w_nb^b for C = R_z(yaw) R_x(pitch) R_y(roll), yaw = -psi
         yaw_dot = -psi_dot
         cr, sr = np.cos(roll), np.sin(roll)
