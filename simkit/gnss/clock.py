@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 
@@ -65,15 +66,24 @@ class ClockProcess:
         """(bias (n,) s, drift (n,) s/s) at the next ``n`` epochs."""
         w = self.rng.standard_normal((n, 2)) @ self.chol.T  # (n, 2) process-noise increments
         if not self.started:
-            w[0] = 0.0  # epoch 0 is the initial state itself
+            w[0] = 0.0  # epoch 0 is the initial state itself: its draw is spent but not used
+            self.x[0] -= self.dt * self.x[1]  # so that the recursion's first step lands on the initial state
             self.started = True
-            steps = np.arange(n)
-        else:
-            steps = np.arange(1, n + 1)
-        b0, d0 = self.x
-        # x_{k+1} = [[1, dt], [0, 1]] x_k + w_k, summed in closed form over the block
-        drift = d0 + np.cumsum(w[:, 1])
-        prev_drift = np.concatenate(([d0], drift[:-1]))
-        bias = b0 + np.cumsum(w[:, 0] + self.dt * prev_drift * (steps > 0))
+        bias, drift = _propagate(self.x[0], self.x[1], self.dt, w)
         self.x = np.array([bias[-1], drift[-1]])
         return bias, drift
+
+
+@numba.njit(cache=True)
+def _propagate(b, d, dt, w):
+    """x_{k+1} = [[1, dt], [0, 1]] x_k + w_k, one step per row of ``w``, sequentially (bit-identical for any
+    split of the epochs into blocks)."""
+    n = w.shape[0]
+    bias = np.empty(n)
+    drift = np.empty(n)
+    for k in range(n):
+        b = b + dt * d + w[k, 0]
+        d = d + w[k, 1]
+        bias[k] = b
+        drift[k] = d
+    return bias, drift

@@ -206,7 +206,7 @@ class GnssSimulator:
         rr = geo["range_rate"]
 
         # --- troposphere and its rate
-        lla = frames.ecef_to_lla(ant_pos)                                   # (M, A, 3)
+        lla = frames.ecef_to_lla(ant_pos.reshape(-1, 3)).reshape(ant_pos.shape)                                   # (M, A, 3)
         lat, lon, hgt = lla[..., 0, None], lla[..., 1, None], lla[..., 2, None]
         el, az = geo["el"], geo["az"]
         el_safe = np.where(np.isfinite(el), np.maximum(el, 1e-3), np.pi / 2)
@@ -347,7 +347,7 @@ class GnssSimulator:
         # line-of-sight rate in ECEF (rotating-frame relative velocity), then elevation/azimuth rates in ENU
         w = v_rot - ant_vel[:, :, None, :]
         u_dot = (w - u * np.einsum("masi,masi->mas", u, w)[..., None]) / rng_[..., None]
-        lla = frames.ecef_to_lla(ant_pos)
+        lla = frames.ecef_to_lla(ant_pos.reshape(-1, 3)).reshape(ant_pos.shape)
         c_en = frames.ecef_to_enu_matrix(lla[..., 0], lla[..., 1])          # (M, A, 3, 3)
         enu = np.einsum("maij,masj->masi", c_en, u)
         enu_dot = np.einsum("maij,masj->masi", c_en, u_dot)
