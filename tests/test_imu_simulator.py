@@ -166,3 +166,31 @@ def test_overrides_beat_preset():
     assert c.rate_hz == 400.0
     assert c.gyro.random_walk == pytest.approx(0.3 * math.pi / 180 / 60)
     assert c.gyro.bias_instability == pytest.approx(0.4518 * math.pi / 180 / 3600)
+
+
+def test_allan_command(tmp_path):
+    import argparse
+
+    import h5py
+
+    from simkit.commands import allan as cmd
+
+    rate, n = 100.0, 60000
+    t = np.arange(n) / rate
+    c = cfg({"gyro": {"arw_deg_per_sqrt_h": 0.5}})
+    gyro, accel, _ = ImuSimulator(c, rate, 1).process(t, np.zeros((n, 3)), np.zeros((n, 3)))
+    path = tmp_path / "imu.h5"
+    with h5py.File(path, "w") as h5:
+        h5["imu/t"], h5["imu/gyro"], h5["imu/accel"] = t, gyro, accel
+    parser = argparse.ArgumentParser()
+    cmd.add_parser(parser.add_subparsers())
+    args = parser.parse_args(["allan", str(path), "--json", str(tmp_path / "a.json"),
+                              "--plot", str(tmp_path / "a.png")])
+    assert cmd.run(args) == 0
+    fitted = json.loads((tmp_path / "a.json").read_text())["fit"]
+    for axis in "xyz":
+        assert fitted[axis]["N"] == pytest.approx(0.5 * math.pi / 180 / 60, rel=0.15)
+    assert (tmp_path / "a.png").stat().st_size > 0
+    with pytest.raises(Exception) as err:
+        cmd.run(parser.parse_args(["allan", str(tmp_path / "a.json")]))
+    assert "a.json" in str(err.value)
