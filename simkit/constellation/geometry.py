@@ -67,6 +67,7 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
         pos = const.state_each(tw, ts)[0]
         rot = _rotate_z(pos, OMEGA_E * tau)
         tau = np.linalg.norm(rot - rx[:, None, :], axis=-1) / C_LIGHT
+        tau = np.where(np.isfinite(tau), tau, 0.075)  # no state: keep a finite time, the state stays NaN
     tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
     out = const.state_each(tw, ts, velocity=velocity)
     pos = _rotate_z(out[0], OMEGA_E * tau)
@@ -75,7 +76,8 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
     los = diff / rng[..., None]
     el, az = elevation_azimuth(rx, los)
     vel = _rotate_z(out[2], OMEGA_E * tau) if velocity else None
-    return Geometry(np.asarray(tw), np.asarray(ts), pos, vel, out[1], out[3] if velocity else None,
+    ts = np.where(np.isfinite(rng), ts, np.nan)
+    return Geometry(np.asarray(tw), ts, pos, vel, out[1], out[3] if velocity else None,
                     rng, rng / C_LIGHT, los, el, az)
 
 

@@ -28,6 +28,8 @@ _GPS_DAY0 = date(1980, 1, 6).toordinal()
 AF0, AF1, AF2, IODE, CRS, DN, M0, CUC, E, CUS, SQRTA, TOE, CIC, OMEGA0, CIS, I0, CRC, OMEGA, OMEGADOT, IDOT, \
     CODES, WEEK, L2P, ACC, HEALTH, TGD1, TGD2 = range(27)
 _REQUIRED = {SQRTA: "sqrt(A)", E: "eccentricity", I0: "i0", OMEGA0: "OMEGA0", TOE: "toe", WEEK: "week", M0: "M0"}
+# lines per RINEX 3 record by system (GLONASS gained a line in 3.05); other letters are not checked
+_RINEX3_LINES = {"G": (8,), "C": (8,), "E": (8,), "J": (8,), "I": (8,), "R": (4, 5), "S": (4,)}
 _CNV_DELAYS = {"CNV1": {24: "ISC_B1Cd", 26: "TGD_B1Cp", 27: "TGD_B2ap"},
                "CNV2": {25: "ISC_B2ad", 26: "TGD_B1Cp", 27: "TGD_B2ap"}}
 
@@ -104,8 +106,13 @@ def _rinex3_blocks(lines, start, path):
         j = i + 1
         while j < n and (not lines[j] or lines[j][0] == " "):
             j += 1
+        block = lines[i:j]
+        if len(block) not in _RINEX3_LINES.get(line[0], (len(block),)):
+            raise DataFileError(path, f"record for {line[:3].strip()} starting here has {len(block)} lines, "
+                                f"expected {' or '.join(map(str, _RINEX3_LINES[line[0]]))} (truncated or malformed)",
+                                i + 1)
         if line[0] in "GC":
-            yield i + 1, "", lines[i:j]
+            yield i + 1, "", block
         i = j
 
 
@@ -134,7 +141,6 @@ def read(path) -> KeplerConstellation:
     ids, vals, delays = [], [], []
     if version < 4.0:
         for ln, _, block in _rinex3_blocks(lines, start, path):
-            _check_len(block, ln, path)
             ids.append(_sat_id(block[0][:3]))
             vals.append(np.append(_values(block, path, ln), _epoch_seconds(block[0][4:23], path, ln)))
     else:
@@ -167,8 +173,8 @@ def read(path) -> KeplerConstellation:
 
 def _check_len(block, ln, path):
     if len(block) != 8:
-        raise DataFileError(path, f"record for {block[0][:3].strip()} has {len(block)} lines, expected 8 "
-                            "(truncated or malformed)", ln + len(block) - 1)
+        raise DataFileError(path, f"record for {block[0][:3].strip()} starting here has {len(block)} lines, "
+                            "expected 8 (truncated or malformed)", ln)
 
 
 def _ion4(block, path, ln) -> Klobuchar:

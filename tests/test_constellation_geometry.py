@@ -1,0 +1,124 @@
+"""Velocities, light time / Sagnac, elevation-azimuth and DOPs against RTKLIB and gnss-lib-py."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from simkit import frames
+from simkit.constellation import dops, kepler, load, receiver_view, visible_count
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
+XIAN = frames.lla_to_ecef(np.radians(34.25), np.radians(108.95), 400.0)
+
+
+def test_analytic_velocity_and_drift_match_central_differences():
+    """GPS, BDS MEO/IGSO/GEO (the GEO rotation included): d/dt of the positions and clocks we return."""
+    c = load("BRDM00DLR_S_20261170000_01D_MN.rnx.gz")
+    sow = 86400.0 + np.arange(600.0, 86000.0, 1800.0)
+    h = 0.01
+    pos, clk, vel, drift = c.state(2416, sow, velocity=True)
+    p_plus, c_plus = c.state(2416, sow + h)
+    p_minus, c_minus = c.state(2416, sow - h)
+    fd_v = (p_plus - p_minus) / (2 * h)
+    fd_d = (c_plus - c_minus) / (2 * h)
+    same = np.isfinite(fd_v[..., 0]) & np.isfinite(vel[..., 0])
+    for kind in ("MEO", "IGSO", "GEO"):
+        m = same & (c.orbit_type == kind)
+        err = np.abs(vel - fd_v)[m].max()
+        print(f"velocity vs central difference, {kind}: max {err:.2e} m/s; drift {np.abs(drift - fd_d)[m].max():.1e}")
+        assert err < 1e-5
+    assert np.abs(drift - fd_d)[same].max() < 1e-14
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason="shared data not available")
+@pytest.mark.filterwarnings("ignore:No ionospheric parameters")
+def test_gps_positions_and_velocities_match_gnss_lib_py():
+    glp = pytest.importorskip("gnss_lib_py.parsers.rinex_nav")
+    from gnss_lib_py.utils.sv_models import find_sv_states
+
+    path = SHARED / "rinex_nav" / "BRDC00WRD_U_20161580000_01D_MN.rnx"
+    nav = glp.RinexNav(str(path), satellites=[f"G{k:02d}" for k in range(1, 33)])
+    c = load(path)
+    p = c.records.params
+    col = kepler.COL
+    ids = np.array(c.sat_ids)[c.records.sat]
+    toe_abs = c.ref_week * 604800.0 + p[:, col["toe"]]
+    ours_idx, ref_t, sat_ref = [], [], []
+    for k in range(nav.shape[1]):
+        t_abs = nav["gps_week"][k] * 604800.0 + nav["t_oe"][k]
+        sid = f"G{int(nav['sv_id'][k]):02d}"
+        match = np.flatnonzero((ids == sid) & (toe_abs == t_abs) & (p[:, col["af0"]] == nav["SVclockBias"][k]))
+        assert match.size, sid
+        ours_idx.append(match[0])
+        ref_t.append(t_abs)
+    ours_idx, ref_t = np.array(ours_idx), np.array(ref_t)
+    worst_p = worst_v = 0.0
+    for dt in (-5400.0, 0.0, 3333.0):
+        sv = find_sv_states((ref_t + dt) * 1e3, nav)
+        ref_pos = np.stack([sv["x_sv_m"], sv["y_sv_m"], sv["z_sv_m"]], -1)
+        ref_vel = np.stack([sv["vx_sv_mps"], sv["vy_sv_mps"], sv["vz_sv_mps"]], -1)
+        pos, _, vel, _ = kepler.propagate(p, ours_idx, p[ours_idx, col["toe"]] + dt, velocity=True)
+        worst_p = max(worst_p, np.linalg.norm(pos - ref_pos, axis=1).max())
+        worst_v = max(worst_v, np.linalg.norm(vel - ref_vel, axis=1).max())
+    print(f"gnss-lib-py GPS ({len(ours_idx)} records x 3 epochs): max |dpos| {worst_p * 1e3:.2f} mm, "
+          f"max |dvel| {worst_v * 1e3:.3f} mm/s")
+    assert worst_p < 0.01 and worst_v < 1e-3
+
+
+def _rtklib_arr(values):
+    import pyrtklib
+
+    arr = pyrtklib.Arr1Ddouble(len(values))
+    for i, v in enumerate(values):
+        arr[i] = float(v)
+    return arr
+
+
+def test_light_time_range_elevation_azimuth_and_dops_match_rtklib():
+    pyrtklib = pytest.importorskip("pyrtklib")
+    c = load("BRDM00DLR_S_20261170000_01D_MN.rnx.gz")
+    sow = 86400.0 + np.arange(0.0, 86400.0, 3600.0)
+    rx = np.repeat(XIAN[None], sow.size, 0)
+    g = receiver_view(c, rx, 2416, sow)
+    # satellite at emission in the ECEF frame of emission, for RTKLIB's geodist (first-order Sagnac)
+    p_tx, _ = c.state_each(g.tx_week, g.tx_sow)
+    lla = frames.ecef_to_lla(XIAN)
+    pos_arr = _rtklib_arr(lla)
+    e = pyrtklib.Arr1Ddouble(3)
+    azel = pyrtklib.Arr1Ddouble(2)
+    d_rng = d_ang = 0.0
+    for m in range(sow.size):
+        for s in np.flatnonzero(np.isfinite(g.range[m])):
+            r = pyrtklib.geodist(_rtklib_arr(p_tx[m, s]), _rtklib_arr(XIAN), e)
+            d_rng = max(d_rng, abs(r - g.range[m, s]))
+            pyrtklib.satazel(pos_arr, _rtklib_arr(g.los[m, s]), azel)
+            d_ang = max(d_ang, abs(azel[1] - g.elevation[m, s]),
+                        abs(np.mod(azel[0] - g.azimuth[m, s] + np.pi, 2 * np.pi) - np.pi))
+    print(f"vs RTKLIB geodist: max |drange| {d_rng * 1e3:.3f} mm; satazel: max |dangle| {d_ang:.1e} rad")
+    assert d_rng < 2e-3 and d_ang < 1e-9
+    mask = np.radians(10.0)
+    ours = dops(g.elevation, g.azimuth, mask)
+    dop = pyrtklib.Arr1Ddouble(4)
+    for m in range(sow.size):
+        ok = np.isfinite(g.elevation[m])
+        az_el = np.stack([g.azimuth[m, ok], g.elevation[m, ok]], -1).ravel()
+        pyrtklib.dops(int(ok.sum()), _rtklib_arr(az_el), mask, dop)
+        np.testing.assert_allclose([ours[k][m] for k in "GPHV"], [dop[i] for i in range(4)], rtol=1e-9)
+    n = visible_count(g.elevation, mask)
+    print(f"Xi'an 2026-04-27, GPS+BDS, 10 deg mask: {n.min()}-{n.max()} satellites, "
+          f"PDOP {np.nanmin(ours['P']):.2f}-{np.nanmax(ours['P']):.2f}")
+
+
+def test_dops_with_one_clock_per_system_and_too_few_satellites():
+    el = np.radians([[30.0, 60.0, 45.0, 80.0, 20.0, 50.0], [30.0, 60.0, 45.0, -5.0, -5.0, -5.0]])
+    az = np.radians([[0.0, 90.0, 180.0, 270.0, 45.0, 200.0]] * 2)
+    system = np.array(["G", "G", "G", "C", "C", "C"])
+    d = dops(el, az, 0.0, system)
+    assert np.isnan(d["P"][1])  # 3 satellites, 4 unknowns
+    # direct least-squares geometry for epoch 0 with two clock columns
+    h = np.stack([-np.cos(el[0]) * np.sin(az[0]), -np.cos(el[0]) * np.cos(az[0]), -np.sin(el[0]),
+                  system == "C", system == "G"], -1).astype(float)
+    q = np.linalg.inv(h.T @ h)
+    np.testing.assert_allclose(d["P"][0], np.sqrt(np.trace(q[:3, :3])))
+    np.testing.assert_allclose(d["G"][0], np.sqrt(np.trace(q)))
+    np.testing.assert_allclose(d["T"][0], np.sqrt(q[3, 3]))
