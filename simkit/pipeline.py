@@ -54,10 +54,13 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
             for name, data in truth.arrays().items():
                 w.append(f"truth/{name}", data, truth.UNITS[name])
             if imu is not None:
-                gyro, accel, errors = imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)
+                block = imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)
+                gyro, accel, errors = block
                 w.append("imu/t", truth.t, "s")
                 w.append("imu/gyro", gyro, "rad/s")
                 w.append("imu/accel", accel, "m/s^2")
+                for name, data in block.increments.items():
+                    w.append(f"imu/{name}", data, "rad" if name == "dtheta" else "m/s")
                 for name, data in errors.items():
                     w.append(f"imu/errors/{name}", data, "rad/s" if name.startswith("gyro") else "m/s^2")
             if gnss is not None:
