@@ -27,12 +27,13 @@ def _p1(var):
 def bootstrap_success_rate(Q=None, d=None, decorrelate_first=True) -> float:
     """Exact success rate of integer bootstrapping: prod_i (2 Phi(1 / (2 sqrt(d_i))) - 1).
 
-    Give ``Q`` (n, n), or the conditional variances ``d`` (n,) directly. With ``decorrelate_first`` it is also the
-    sharpest easy lower bound of the ILS success rate (Teunissen 1999).
+    Give ``Q`` (n, n), or the conditional variances ``d`` (n,) directly (or stacked (K, n): returns (K,)). With
+    ``decorrelate_first`` it is also the sharpest easy lower bound of the ILS success rate (Teunissen 1999).
     """
     if d is None:
         d = _cond_variances(Q, decorrelate_first)
-    return float(np.prod(_p1(d)))
+    p = np.prod(_p1(d), axis=-1)
+    return float(p) if np.ndim(p) == 0 else p
 
 
 def adop(Q) -> float:

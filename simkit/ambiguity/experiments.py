@@ -1,0 +1,149 @@
+"""Single-epoch, single-frequency attitude experiment: constrained (C-LAMBDA) vs plain LAMBDA success rates.
+
+Simulated model (documented in docs/ambiguity.md), each piece replaceable:
+- geometry: ``los_sampler(rng, n_sats, trials) -> (trials, n_sats, 3)`` unit line-of-sight vectors (local ENU).
+  The default draws satellites uniformly over the sky above the elevation mask (sin(elevation) uniform, azimuth
+  uniform); simkit.gnss line-of-sight vectors of a real constellation can be passed instead.
+- observations: double differences against the highest satellite, between a master antenna and r others,
+  ``carrier = G b / lambda + a + noise`` (cycles) and ``code = G b + noise`` (m), ``G = -(e_j - e_ref)``; the noise
+  is undifferenced white noise (sigma_phase, sigma_code, no elevation weighting) pushed through the differencing,
+  so the DD covariance is exact. :func:`float_solution` takes any such DD observations (e.g. from simkit.gnss).
+- baselines: length uniform in ``length_range_m``, heading uniform, elevation uniform in +-10 deg.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..rng import generator
+from .constrained import baseline_constrained_ils
+from .search import ils_batch
+from .success import bootstrap_success_rate
+
+GPS_L1_WAVELENGTH_M = 299_792_458.0 / 1575.42e6
+
+
+@dataclass(frozen=True)
+class FloatSolution:
+    """Float solution of T epochs for r baselines: a_hat (T, r n) cycles, b_hat (T, 3 r) m, Qa, Qb, Qba."""
+
+    a_hat: np.ndarray
+    b_hat: np.ndarray
+    Qa: np.ndarray
+    Qb: np.ndarray
+    Qba: np.ndarray
+
+
+def float_solution(G, carrier_cycles, code_m, wavelength_m, sigma_phase_m, sigma_code_m) -> FloatSolution:
+    """Least-squares float solution of single-epoch DD carrier and code for r baselines from one master antenna.
+
+    ``G`` (T, n, 3): DD geometry rows (DD range = G b, m per m); ``carrier_cycles`` and ``code_m`` (T, r, n) DDs;
+    sigmas are of undifferenced observations (m). The DD noise of baseline k is D(e_k - e_master) with D the
+    between-satellite difference, so Cov(DD_k, DD_l) = (1 + [k == l]) sigma^2 D D^T; that Kronecker structure
+    gives the same estimator per baseline and Cov(x_k, x_l) = (1 + [k == l]) Qx0.
+    """
+    T, n, _ = G.shape
+    r = carrier_cycles.shape[1]
+    C0 = np.eye(n) + np.ones((n, n))  # D D^T
+    Ci = np.linalg.inv(C0)
+    wp, wc = 1.0 / sigma_phase_m**2, 1.0 / sigma_code_m**2
+    lam = wavelength_m
+    # normal equations for x = [a (cycles); b (m)], carrier in metres = lam * carrier_cycles
+    N = np.zeros((T, n + 3, n + 3))
+    N[:, :n, :n] = lam**2 * wp * Ci
+    N[:, :n, n:] = lam * wp * Ci @ G
+    N[:, n:, :n] = np.swapaxes(N[:, :n, n:], 1, 2)
+    N[:, n:, n:] = (wp + wc) * np.swapaxes(G, 1, 2) @ Ci @ G
+    Qx0 = np.linalg.inv(N)
+    Qx0 = 0.5 * (Qx0 + np.swapaxes(Qx0, 1, 2))
+    phi_m = lam * carrier_cycles
+    rhs = np.concatenate([lam * wp * (phi_m @ Ci),
+                          (wp * phi_m + wc * code_m) @ Ci @ G], axis=2)  # (T, r, n + 3)
+    x = np.einsum("tij,trj->tri", Qx0, rhs)
+    S = np.eye(r) + np.ones((r, r))
+    Qa = np.einsum("kl,tij->tkilj", S, Qx0[:, :n, :n]).reshape(T, r * n, r * n)
+    Qb = np.einsum("kl,tij->tkilj", S, Qx0[:, n:, n:]).reshape(T, 3 * r, 3 * r)
+    Qba = np.einsum("kl,tij->tkilj", S, Qx0[:, n:, :n]).reshape(T, 3 * r, r * n)
+    return FloatSolution(x[:, :, :n].reshape(T, r * n), x[:, :, n:].reshape(T, 3 * r), Qa, Qb, Qba)
+
+
+def sky_uniform_los(rng, n_sats, trials, mask_deg=10.0):
+    """Unit vectors (trials, n_sats, 3) in ENU uniformly distributed over the sky above ``mask_deg``."""
+    sin_el = rng.uniform(np.sin(np.radians(mask_deg)), 1.0, (trials, n_sats))
+    az = rng.uniform(0.0, 2 * np.pi, (trials, n_sats))
+    cos_el = np.sqrt(1.0 - sin_el**2)
+    return np.stack([cos_el * np.sin(az), cos_el * np.cos(az), sin_el], axis=-1)
+
+
+def simulate_epochs(rng, los, baselines_m, wavelength_m, sigma_phase_m, sigma_code_m):
+    """DD geometry, observations and true DD ambiguities for baselines (T, 3, r) seen along ``los`` (T, S, 3).
+
+    Returns (G (T, S-1, 3), carrier (T, r, S-1) cycles, code (T, r, S-1) m, a_true (T, r, S-1) int64).
+    """
+    T, S, _ = los.shape
+    r = baselines_m.shape[2]
+    ref = np.argmax(los[:, :, 2], axis=1)
+    others = np.array([np.delete(np.arange(S), i) for i in ref])  # (T, S-1)
+    e_ref = los[np.arange(T), ref]
+    e_oth = np.take_along_axis(los, others[:, :, None], axis=1)
+    G = -(e_oth - e_ref[:, None, :])
+    rho = np.einsum("tsi,tir->trs", G, baselines_m)  # DD ranges (T, r, S-1)
+
+    def dd_noise(sigma):  # undifferenced noise at r + 1 antennas, differenced between antennas and satellites
+        e = sigma * rng.standard_normal((T, r + 1, S))
+        sd = e[:, 1:, :] - e[:, :1, :]
+        return np.take_along_axis(sd, others[:, None, :], axis=2) - sd[np.arange(T), :, ref][:, :, None]
+
+    a_true = rng.integers(-50, 51, (T, r, S - 1))
+    carrier = rho / wavelength_m + a_true + dd_noise(sigma_phase_m) / wavelength_m
+    code = rho + dd_noise(sigma_code_m)
+    return G, carrier, code, a_true
+
+
+def random_baselines(rng, trials, length_range_m=(1.0, 2.0)):
+    """(trials, 3, 1) ENU baselines: length uniform in the range, heading uniform, elevation uniform in +-10 deg."""
+    length = rng.uniform(*length_range_m, trials)
+    hdg = rng.uniform(0.0, 2 * np.pi, trials)
+    el = np.radians(rng.uniform(-10.0, 10.0, trials))
+    b = length[:, None] * np.stack([np.cos(el) * np.sin(hdg), np.cos(el) * np.cos(hdg), np.sin(el)], axis=1)
+    return b[:, :, None]
+
+
+def success_table(n_sats=range(4, 11), trials=1000, seed=0, sigma_phase_m=0.003, sigma_code_m=0.30,
+                  wavelength_m=GPS_L1_WAVELENGTH_M, length_range_m=(1.0, 2.0), los_sampler=sky_uniform_los):
+    """Empirical single-epoch success rates of plain ILS and C-LAMBDA for each number of satellites.
+
+    Returns a list of dicts: ``n_sats``, ``trials``, ``ils`` and ``constrained`` (success fractions),
+    ``bootstrap`` (mean exact IB success rate of the float Qa), ``unfinished`` (constrained searches that hit the
+    work cap, counted as failures). Deterministic for a given ``seed`` (named streams per row).
+    """
+    rows = []
+    for s in n_sats:
+        rng = generator(seed, "ambiguity", "success_table", str(s))
+        los = los_sampler(rng, s, trials)
+        b = random_baselines(rng, trials, length_range_m)
+        G, carrier, code, a_true = simulate_epochs(rng, los, b, wavelength_m, sigma_phase_m, sigma_code_m)
+        fs = float_solution(G, carrier, code, wavelength_m, sigma_phase_m, sigma_code_m)
+        truth = a_true[:, 0, :]
+        plain = ils_batch(fs.a_hat, fs.Qa, n_cands=1)
+        con = baseline_constrained_ils(fs.a_hat, fs.Qa, fs.b_hat, fs.Qb, fs.Qba, np.linalg.norm(b[:, :, 0], axis=1),
+                                       n_cands=1)
+        boot = bootstrap_success_rate(d=plain.d)
+        rows.append({
+            "n_sats": int(s), "trials": int(trials),
+            "ils": float(np.mean(np.all(plain.candidates[:, 0] == truth, axis=1))),
+            "constrained": float(np.mean(np.all(con.candidates[:, 0] == truth, axis=1) & con.finished)),
+            "bootstrap": float(np.mean(boot)),
+            "unfinished": int(np.sum(~con.finished)),
+        })
+    return rows
+
+
+def format_table(rows) -> str:
+    """The rows of :func:`success_table` as a Markdown table."""
+    lines = ["| satellites | trials | LAMBDA (ILS) | C-LAMBDA | bootstrapped SR (mean) |", "|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['n_sats']} | {r['trials']} | {r['ils']:.3f} | {r['constrained']:.3f} | "
+                     f"{r['bootstrap']:.3f} |")
+    return "\n".join(lines)
