@@ -6,8 +6,8 @@ near the horizon, small at zenith (the exponential elevation profile of Kee & Pa
 """
 from __future__ import annotations
 
+import numba
 import numpy as np
-from scipy.signal import lfilter
 
 
 def elevation_scale(el, sigma_horizon, el0_rad):
@@ -16,30 +16,36 @@ def elevation_scale(el, sigma_horizon, el0_rad):
 
 
 class GaussMarkov:
-    """A bank of independent unit-variance first-order Gauss-Markov processes, advanced block by block.
+    """A bank of unit-variance first-order Gauss-Markov processes (A, S, G, 2), advanced block by block.
 
-    ``advance(w)`` takes standard-normal driving noise ``w`` (n, ...) in epoch order and returns the process at
-    those n epochs; the first epoch of the first call is the stationary initial value sqrt(1) w_0.
+    A process restarts from its stationary distribution (x = w) at each (re)acquisition of its satellite:
+    multipath after an outage is independent of what it was before. Only the visible satellites' columns are
+    advanced; the recursion runs epoch by epoch (numba), so any block split gives the same values.
     """
 
     def __init__(self, dt: float, tau: float, shape: tuple):
         self.phi = float(np.exp(-dt / tau))
         self.gain = float(np.sqrt(1.0 - self.phi**2))
-        self.state = None
-        self.shape = shape
+        self.state = np.zeros(shape)
 
-    def advance(self, w: np.ndarray) -> np.ndarray:
-        n = w.shape[0]
-        w = w.reshape(n, -1)
-        if self.state is None:
-            # stationary start: x_0 = w_0, then the recursion
-            x0 = w[0]
-            rest = w[1:]
-            out = np.empty_like(w)
-            out[0] = x0
-            if n > 1:
-                out[1:], _ = lfilter([self.gain], [1.0, -self.phi], rest, axis=0, zi=(self.phi * x0)[None, :])
-        else:
-            out, _ = lfilter([self.gain], [1.0, -self.phi], w, axis=0, zi=(self.phi * self.state)[None, :])
-        self.state = out[-1].copy()
-        return out.reshape((n,) + self.shape)
+    def advance(self, w: np.ndarray, restart: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """``w`` (M, A, C, G, 2) standard normals for satellite columns ``cols`` (C,), ``restart`` (M, A, C)."""
+        m, a, c = restart.shape
+        x0 = self.state[:, cols].reshape(-1)
+        k = w[0].size // (a * c)
+        flags = np.repeat(restart.reshape(m, a * c), k, axis=1)
+        x = _recursion(w.reshape(m, -1), flags, x0, self.phi, self.gain)
+        self.state[:, cols] = x[-1].reshape(self.state[:, cols].shape)
+        return x.reshape(w.shape)
+
+
+@numba.njit(cache=True)
+def _recursion(w, restart, x0, phi, gain):
+    m, n = w.shape
+    out = np.empty((m, n))
+    x = x0.copy()
+    for k in range(m):
+        for i in range(n):
+            x[i] = w[k, i] if restart[k, i] else phi * x[i] + gain * w[k, i]
+            out[k, i] = x[i]
+    return out

@@ -62,7 +62,7 @@ class _Sky:
             for c in self.consts:
                 parts.append(receiver_view(c, rx, week, sow, velocity=True))
         cat = lambda name: np.concatenate([getattr(p, name) for p in parts], axis=1)  # noqa: E731
-        return {k: cat(k) for k in ("sat_pos", "sat_vel", "sat_clock", "sat_drift", "tau")}
+        return {k: cat(k) for k in ("sat_pos", "sat_vel", "sat_clock", "sat_drift", "tau", "elevation")}
 
     def klobuchar(self, system):
         for c in self.consts:
@@ -135,8 +135,9 @@ class GnssSimulator:
                           for a in range(self.n_ant)]
         self.event_rng = [[rng.generator(seed, "gnss", f"ant{a}", sid, "events") for sid in self.sat_ids]
                           for a in range(self.n_ant)]
-        mp = cfg.multipath
-        self.mp = GaussMarkov(self.dt, mp.correlation_time_s, (self.n_ant, s, g, 2))
+        self.sys_signals = [np.flatnonzero([sg.system == sys for sg in self.signals]) for sys in self.system]
+        self.mp = GaussMarkov(self.dt, cfg.multipath.correlation_time_s, (self.n_ant, s, g, 2))
+        self.vis = np.zeros((self.n_ant, s), dtype=bool)
         self.tracked = np.zeros((self.n_ant, s, g), dtype=bool)
         self.amb = np.zeros((self.n_ant, s, g), dtype=np.int64)
         rate = cfg.slip_rate_per_h / 3600.0
@@ -170,77 +171,94 @@ class GnssSimulator:
 
     def process(self, t, pos_ecef, vel_ecef, quat_nb, omega_ib_b) -> dict:
         """Observables at epochs ``t`` (M,) s from the truth there (IMU centre, ECEF; body->ENU attitude;
-        body rate w.r.t. inertial space). Returns relative path under /gnss -> (array, units)."""
+        body rate w.r.t. inertial space). Returns relative path under /gnss -> (array, units).
+
+        Per-antenna work is done only for the satellites above the elevation mask at some epoch of the block
+        (the "candidate" columns); arrays are NaN elsewhere.
+        """
         t = np.asarray(t, dtype=float)
         m = t.size
         cfg, err = self.cfg, self.cfg.errors
         pos = np.asarray(pos_ecef, dtype=float).reshape(m, 3)
         vel = np.asarray(vel_ecef, dtype=float).reshape(m, 3)
         week, sow = gpstime.add_seconds(self.start_week, self.start_sow, t)
+        s_count, a_count = len(self.sat_ids), self.n_ant
 
         ant_pos, ant_vel, c_be = self._antennas(pos, vel, quat_nb, omega_ib_b)
         ref = self.sky.view(pos, week, sow)
-        geo = self._antenna_geometry(ref, ant_pos, ant_vel)
-        s_count, g_count = len(self.sat_ids), len(self.signals)
+        with np.errstate(invalid="ignore"):
+            cand = np.flatnonzero((ref["elevation"] >= cfg.elevation_mask_rad - 1e-3).any(axis=0))
+        geo = self._antenna_geometry({k: v[:, cand] for k, v in ref.items()}, ant_pos, ant_vel)
 
-        # --- visibility
+        def full(x, fill=np.nan):
+            out = np.full((m, a_count, s_count), fill, dtype=np.asarray(x).dtype)
+            out[..., cand] = x
+            return out
+
+        # --- visibility: elevation mask, body-frame horizon of each antenna, scheduled outages
         bore_e = np.einsum("mij,aj->mai", c_be, self.boresight)            # (M, A, 3)
-        cos_off = np.einsum("masi,mai->mas", geo["los"], bore_e)
-        off = np.arccos(np.clip(cos_off, -1.0, 1.0))
-        horizon = np.array([a.horizon_mask_rad for a in cfg.antennas])
-        vis = (np.isfinite(geo["range"]) & (geo["el"] >= cfg.elevation_mask_rad)
-               & (np.pi / 2.0 - off >= horizon[None, :, None]))
+        off = np.arccos(np.clip(np.einsum("maci,mai->mac", geo["los"], bore_e), -1.0, 1.0))
+        horizon = np.array([x.horizon_mask_rad for x in cfg.antennas])
+        vis_c = (np.isfinite(geo["range"]) & (geo["el"] >= cfg.elevation_mask_rad)
+                 & (np.pi / 2.0 - off >= horizon[None, :, None]))
         for o in cfg.outages:
             rows = (t >= o.start_s) & (t < o.end_s)
-            ants = np.zeros(self.n_ant, dtype=bool)
+            ants = np.zeros(a_count, dtype=bool)
             ants[list(o.antennas) if o.antennas is not None else slice(None)] = True
             sats = np.zeros(s_count, dtype=bool)
             sats[[self.sat_index[x] for x in o.sats] if o.sats is not None else slice(None)] = True
-            vis[rows] &= ~(ants[:, None] & sats[None, :])
+            vis_c[rows] &= ~(ants[:, None] & sats[cand][None, :])
+        vis = full(vis_c, False)
         tracked = vis[..., None] & self.carries[None, None, :, :]         # (M, A, S, G)
+        prev_vis = np.concatenate([self.vis[None], vis[:-1]], axis=0)
+        restart = (vis & ~prev_vis)[..., cand]                             # (re)acquisitions, (M, A, C)
+        self.vis = vis[-1].copy()
 
-        # --- clocks
+        # --- clocks (receiver per antenna or common; satellite at each antenna's emission time)
         dtr, ddtr = self._clock(m)                                          # (M, A)
-        dts = np.where(np.isfinite(geo["sat_clock"]), geo["sat_clock"], 0.0)  # (M, A, S)
-        ddts = np.where(np.isfinite(geo["sat_drift"]), geo["sat_drift"], 0.0)
         rr = geo["range_rate"]
+        rx_clk = C_LIGHT * dtr * err["receiver_clock"]
+        rx_clk_rate = C_LIGHT * ddtr * err["receiver_clock"]
+        sat_clk = -C_LIGHT * np.nan_to_num(geo["sat_clock"]) * err["satellite_clock"]
+        sat_clk_rate = -C_LIGHT * np.nan_to_num(geo["sat_drift"]) * (1.0 - rr / C_LIGHT) * err["satellite_clock"]
+        clk = rx_clk[..., None] + sat_clk
+        clk_rate = rx_clk_rate[..., None] + sat_clk_rate
 
         # --- troposphere and its rate
-        lla = frames.ecef_to_lla(ant_pos.reshape(-1, 3)).reshape(ant_pos.shape)                                   # (M, A, 3)
+        lla = frames.ecef_to_lla(ant_pos.reshape(-1, 3)).reshape(ant_pos.shape)  # (M, A, 3)
         lat, lon, hgt = lla[..., 0, None], lla[..., 1, None], lla[..., 2, None]
-        el, az = geo["el"], geo["az"]
-        el_safe = np.where(np.isfinite(el), np.maximum(el, 1e-3), np.pi / 2)
-        az_safe = np.where(np.isfinite(az), az, 0.0)
+        el_safe = np.where(np.isfinite(geo["el"]), np.maximum(geo["el"], 1e-3), np.pi / 2)
+        az_safe = np.where(np.isfinite(geo["az"]), geo["az"], 0.0)
         if err["troposphere"]:
             zh, zw = atmosphere.saastamoinen_zenith(lat, hgt)
             trop = (zh + zw) / np.sin(el_safe)
             trop_rate = -(zh + zw) * np.cos(el_safe) / np.sin(el_safe) ** 2 * geo["el_rate"]
         else:
-            trop = trop_rate = np.zeros((m, self.n_ant, s_count))
+            trop = trop_rate = np.zeros(el_safe.shape)
 
-        # --- ionosphere (per system model, scaled per signal) and its rate (central difference, h = 0.5 s)
-        iono_ref = np.zeros((m, self.n_ant, s_count))
-        iono_ref_rate = np.zeros_like(iono_ref)
+        # --- ionosphere (per-system broadcast model at its reference frequency) and its rate (central
+        # difference over +-0.5 s along the line-of-sight motion)
+        iono_ref = np.zeros(el_safe.shape)
+        iono_ref_rate = np.zeros(el_safe.shape)
         if err["ionosphere"]:
-            tow = sow[:, None, None]
             h = 0.5
+            tow = sow[:, None, None]
             for letter, model, shift in (("G", atmosphere.klobuchar_gps, 0.0),
                                          ("C", atmosphere.klobuchar_bds, gpstime.BDT_MINUS_GPST)):
-                cols = self.system == letter
+                cols = self.system[cand] == letter
                 if not cols.any():
                     continue
                 alpha, beta = self.iono[letter]
-                args = (lat, lon)
-                e, a = el_safe[..., cols], az_safe[..., cols]
+                e, az = el_safe[..., cols], az_safe[..., cols]
                 er, ar = geo["el_rate"][..., cols], geo["az_rate"][..., cols]
-                iono_ref[..., cols] = model(alpha, beta, *args, a, e, tow + shift)
-                up = model(alpha, beta, *args, a + ar * h, e + er * h, tow + shift + h)
-                dn = model(alpha, beta, *args, a - ar * h, e - er * h, tow + shift - h)
+                iono_ref[..., cols] = model(alpha, beta, lat, lon, az, e, tow + shift)
+                up = model(alpha, beta, lat, lon, az + ar * h, e + er * h, tow + shift + h)
+                dn = model(alpha, beta, lat, lon, az - ar * h, e - er * h, tow + shift - h)
                 iono_ref_rate[..., cols] = (up - dn) / (2.0 * h)
 
-        # --- C/N0, noise sigmas, random draws
-        draws = self._draws(m)                                              # (M, A, S, G, 5)
-        mpx = self.mp.advance(draws[..., 3:5]) if err["multipath"] else None
+        # --- random parts
+        draws = self._draws(vis_c, cand)                                    # (M, A, C, G, 5)
+        mpx = self.mp.advance(draws[..., 3:5], restart, cand) if err["multipath"] else None
         amb, lli = self._ambiguities(t, tracked)
 
         out = {"t": (t, "s")}
@@ -248,65 +266,66 @@ class GnssSimulator:
         out["sat_clock"] = (ref["sat_clock"], "s")
         out["truth/antenna_pos_ecef"] = (ant_pos, "m")
         out["truth/antenna_vel_ecef"] = (ant_vel, "m/s")
-        out["truth/range"] = (geo["range"], "m")
-        out["truth/range_rate"] = (rr, "m/s")
-        out["truth/elevation"] = (el, "rad")
-        out["truth/azimuth"] = (az, "rad")
-        out["truth/receiver_clock"] = (dtr * C_LIGHT if err["receiver_clock"] else np.zeros_like(dtr), "m")
-        out["truth/receiver_clock_drift"] = (ddtr * C_LIGHT if err["receiver_clock"] else np.zeros_like(dtr),
-                                             "m/s")
-        sc = err["satellite_clock"]
-        out["truth/satellite_clock"] = (-C_LIGHT * dts * sc, "m")
-        out["truth/satellite_clock_drift"] = (-C_LIGHT * ddts * (1.0 - rr / C_LIGHT) * sc, "m/s")
-        out["truth/troposphere"] = (trop, "m")
-        out["truth/troposphere_rate"] = (trop_rate, "m/s")
+        out["truth/range"] = (full(geo["range"]), "m")
+        out["truth/range_rate"] = (full(rr), "m/s")
+        out["truth/elevation"] = (full(geo["el"]), "rad")
+        out["truth/azimuth"] = (full(geo["az"]), "rad")
+        out["truth/receiver_clock"] = (rx_clk, "m")
+        out["truth/receiver_clock_drift"] = (rx_clk_rate, "m/s")
+        out["truth/satellite_clock"] = (full(sat_clk), "m")
+        out["truth/satellite_clock_drift"] = (full(sat_clk_rate), "m/s")
+        out["truth/troposphere"] = (full(trop), "m")
+        out["truth/troposphere_rate"] = (full(trop_rate), "m/s")
 
-        clk = out["truth/receiver_clock"][0][..., None] + out["truth/satellite_clock"][0]
-        clk_rate = out["truth/receiver_clock_drift"][0][..., None] + out["truth/satellite_clock_drift"][0]
-        off_b = off
+        rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
+        on = err["noise"]
         for j, g in enumerate(self.signals):
-            trk = tracked[..., j]
-            cn0 = noise.cn0_dbhz(off_b, cfg.cn0_zenith_dbhz, np.array([a.rolloff_db for a in cfg.antennas])
-                                 [None, :, None], g.cn0_offset_db)
+            cj = np.flatnonzero(self.carries[cand, j])                      # candidate columns with signal j
+            sel = (Ellipsis, cj)
+            cn0 = noise.cn0_dbhz(off[sel], cfg.cn0_zenith_dbhz, rolloff, g.cn0_offset_db)
             sig_c, sig_p, sig_d = self._sigmas(cn0, g)
-            scale = (atmosphere.F_L1 if g.system == "G" else atmosphere.F_B1I) / g.freq_hz
-            iono = iono_ref * scale**2
-            iono_rate = iono_ref_rate * scale**2
-            gd = C_LIGHT * self.group_delay_s[:, j] * err["group_delay"]
+            scale = ((atmosphere.F_L1 if g.system == "G" else atmosphere.F_B1I) / g.freq_hz) ** 2
+            iono, iono_rate = iono_ref[sel] * scale, iono_ref_rate[sel] * scale
+            gd = C_LIGHT * self.group_delay_s[cand[cj], j] * err["group_delay"]
             if mpx is not None:
-                mp_c = elevation_scale(el_safe, cfg.multipath.code_sigma_m, cfg.multipath.elevation_scale_rad) \
-                    * mpx[:, :, :, j, 0]
-                mp_p = elevation_scale(el_safe, cfg.multipath.carrier_sigma_m,
-                                       cfg.multipath.elevation_scale_rad) * mpx[:, :, :, j, 1]
+                mp_c = elevation_scale(el_safe[sel], cfg.multipath.code_sigma_m,
+                                       cfg.multipath.elevation_scale_rad) * mpx[:, :, cj, j, 0]
+                mp_p = elevation_scale(el_safe[sel], cfg.multipath.carrier_sigma_m,
+                                       cfg.multipath.elevation_scale_rad) * mpx[:, :, cj, j, 1]
             else:
-                mp_c = mp_p = np.zeros((m, self.n_ant, s_count))
-            on = err["noise"]
-            n_c = draws[..., j, 0] * sig_c * on
-            n_p = draws[..., j, 1] * sig_p * on
-            n_d = draws[..., j, 2] * sig_d * on
-            code = geo["range"] + clk + gd + iono + trop + mp_c + n_c
-            phase_m = geo["range"] + clk - iono + trop + mp_p + n_p
-            carrier = phase_m / g.wavelength_m + amb[..., j]
-            doppler = -(rr + clk_rate - iono_rate + trop_rate) / g.wavelength_m + n_d
-            nan = ~trk
-            p = f"obs/{g.name}"
-            out[f"{p}/code"] = (np.where(nan, np.nan, code), "m")
-            out[f"{p}/carrier"] = (np.where(nan, np.nan, carrier), "cycles")
-            out[f"{p}/doppler"] = (np.where(nan, np.nan, doppler), "Hz")
-            out[f"{p}/cn0"] = (np.where(nan, np.nan, cn0), "dB-Hz")
+                mp_c = mp_p = np.zeros(cn0.shape)
+            n_c = draws[:, :, cj, j, 0] * sig_c * on
+            n_p = draws[:, :, cj, j, 1] * sig_p * on
+            n_d = draws[:, :, cj, j, 2] * sig_d * on
+            base = geo["range"][sel] + clk[sel] + trop[sel]
+            code = base + gd + iono + mp_c + n_c
+            carrier = (base - iono + mp_p + n_p) / g.wavelength_m + amb[..., cand[cj], j]
+            doppler = -(rr[sel] + clk_rate[sel] - iono_rate + trop_rate[sel]) / g.wavelength_m + n_d
+            keep = tracked[..., cand[cj], j]
+            cols = cand[cj]
+
+            def put(x, fill=np.nan, mask=True):
+                res = np.full((m, a_count, s_count), fill)
+                res[..., cols] = np.where(keep, x, fill) if mask else x
+                return res
+
+            p, q = f"obs/{g.name}", f"truth/{g.name}"
+            out[f"{p}/code"] = (put(code), "m")
+            out[f"{p}/carrier"] = (put(carrier), "cycles")
+            out[f"{p}/doppler"] = (put(doppler), "Hz")
+            out[f"{p}/cn0"] = (put(cn0), "dB-Hz")
             out[f"{p}/ambiguity"] = (amb[..., j], "cycles")
             out[f"{p}/lli"] = (lli[..., j], "")
-            q = f"truth/{g.name}"
-            out[f"{q}/ionosphere"] = (iono, "m")
-            out[f"{q}/ionosphere_rate"] = (iono_rate, "m/s")
-            out[f"{q}/multipath_code"] = (mp_c, "m")
-            out[f"{q}/multipath_carrier"] = (mp_p, "m")
-            out[f"{q}/noise_code"] = (n_c, "m")
-            out[f"{q}/noise_carrier"] = (n_p, "m")
-            out[f"{q}/noise_doppler"] = (n_d, "Hz")
-            out[f"{q}/sigma_code"] = (sig_c * on, "m")
-            out[f"{q}/sigma_carrier"] = (sig_p * on, "m")
-            out[f"{q}/sigma_doppler"] = (sig_d * on, "Hz")
+            out[f"{q}/ionosphere"] = (put(iono, mask=False), "m")
+            out[f"{q}/ionosphere_rate"] = (put(iono_rate, mask=False), "m/s")
+            out[f"{q}/multipath_code"] = (put(mp_c), "m")
+            out[f"{q}/multipath_carrier"] = (put(mp_p), "m")
+            out[f"{q}/noise_code"] = (put(n_c), "m")
+            out[f"{q}/noise_carrier"] = (put(n_p), "m")
+            out[f"{q}/noise_doppler"] = (put(n_d), "Hz")
+            out[f"{q}/sigma_code"] = (put(sig_c * on), "m")
+            out[f"{q}/sigma_carrier"] = (put(sig_p * on), "m")
+            out[f"{q}/sigma_doppler"] = (put(sig_d * on), "Hz")
         return out
 
     # ------------------------------------------------------------------ pieces
@@ -369,13 +388,20 @@ class GnssSimulator:
             drift = np.repeat(drift, self.n_ant, axis=1)
         return bias, drift
 
-    def _draws(self, m):
-        """Standard normals (M, A, S, G, 5) [code, carrier, Doppler, multipath code, multipath carrier]."""
-        g = len(self.signals)
-        out = np.empty((m, self.n_ant, len(self.sat_ids), g, 5))
-        for a in range(self.n_ant):
-            for k, gen in enumerate(self.noise_rng[a]):
-                out[:, a, k] = gen.standard_normal((m, g, 5))
+    def _draws(self, vis_c, cand):
+        """Standard normals (M, A, C, G, 5) [code, carrier, Doppler, multipath code, multipath carrier] for
+        the candidate columns; zero where the satellite is not visible. Each (antenna, satellite) stream draws
+        5 numbers per signal of its system at each epoch where it is visible, in epoch order, so the draws do not
+        depend on how the epochs are split into blocks."""
+        m, a_count, c_count = vis_c.shape
+        out = np.zeros((m, a_count, c_count, len(self.signals), 5))
+        for a in range(a_count):
+            for c, s in enumerate(cand):
+                rows = np.flatnonzero(vis_c[:, a, c])
+                if rows.size:
+                    sigs = self.sys_signals[s]
+                    out[rows[:, None], a, c, sigs[None, :]] = self.noise_rng[a][s].standard_normal(
+                        (rows.size, sigs.size, 5))
         return out
 
     def _sigmas(self, cn0, g):
