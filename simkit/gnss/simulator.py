@@ -236,8 +236,8 @@ class GnssSimulator:
         else:
             trop = trop_rate = np.zeros(el_safe.shape)
 
-        # --- ionosphere (per-system broadcast model at its reference frequency) and its rate (central
-        # difference over +-0.5 s along the line-of-sight motion)
+        # --- ionosphere (per-system broadcast model at its reference frequency) and its rate (difference over
+        # 0.5 s along the line-of-sight motion: the delay's curvature makes that < 1e-6 m/s)
         iono_ref = np.zeros(el_safe.shape)
         iono_ref_rate = np.zeros(el_safe.shape)
         if err["ionosphere"]:
@@ -253,8 +253,7 @@ class GnssSimulator:
                 er, ar = geo["el_rate"][..., cols], geo["az_rate"][..., cols]
                 iono_ref[..., cols] = model(alpha, beta, lat, lon, az, e, tow + shift)
                 up = model(alpha, beta, lat, lon, az + ar * h, e + er * h, tow + shift + h)
-                dn = model(alpha, beta, lat, lon, az - ar * h, e - er * h, tow + shift - h)
-                iono_ref_rate[..., cols] = (up - dn) / (2.0 * h)
+                iono_ref_rate[..., cols] = (up - iono_ref[..., cols]) / h
 
         # --- random parts
         draws = self._draws(vis_c, cand)                                    # (M, A, C, G, 5)
@@ -318,14 +317,14 @@ class GnssSimulator:
             out[f"{p}/lli"] = (lli[..., j], "")
             out[f"{q}/ionosphere"] = (put(iono, mask=False), "m")
             out[f"{q}/ionosphere_rate"] = (put(iono_rate, mask=False), "m/s")
-            out[f"{q}/multipath_code"] = (put(mp_c), "m")
-            out[f"{q}/multipath_carrier"] = (put(mp_p), "m")
-            out[f"{q}/noise_code"] = (put(n_c), "m")
-            out[f"{q}/noise_carrier"] = (put(n_p), "m")
-            out[f"{q}/noise_doppler"] = (put(n_d), "Hz")
-            out[f"{q}/sigma_code"] = (put(sig_c * on), "m")
-            out[f"{q}/sigma_carrier"] = (put(sig_p * on), "m")
-            out[f"{q}/sigma_doppler"] = (put(sig_d * on), "Hz")
+            out[f"{q}/multipath_code"] = (put(mp_c, mask=False), "m")
+            out[f"{q}/multipath_carrier"] = (put(mp_p, mask=False), "m")
+            out[f"{q}/noise_code"] = (put(n_c, mask=False), "m")
+            out[f"{q}/noise_carrier"] = (put(n_p, mask=False), "m")
+            out[f"{q}/noise_doppler"] = (put(n_d, mask=False), "Hz")
+            out[f"{q}/sigma_code"] = (put(sig_c * on, mask=False), "m")
+            out[f"{q}/sigma_carrier"] = (put(sig_p * on, mask=False), "m")
+            out[f"{q}/sigma_doppler"] = (put(sig_d * on, mask=False), "Hz")
         return out
 
     # ------------------------------------------------------------------ pieces
