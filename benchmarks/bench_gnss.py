@@ -102,7 +102,8 @@ def main():
     triples = n_obs / 4 * 2  # observations of one signal pair ~ (epoch, antenna, tracked satellite) triples
     print(f"simkit gnss: {args.hours:g} h at 1 Hz = {m} epochs, {s} satellites (GPS+BDS), 3 antennas, 2 signals "
           f"per satellite: {sec:.1f} s ({n_obs / sec / 1e6:.2f} M observations/s); peak RSS {rss:.0f} MB")
-    print(f"  target < 20 s: {'PASS' if sec < 20 else 'FAIL'}")
+    if args.hours == 24.0:
+        print(f"  target < 20 s: {'PASS' if sec < 20 else 'FAIL'}")
     try:
         per = peer()
     except Exception as exc:  # the peer is optional
