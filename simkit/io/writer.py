@@ -1,12 +1,17 @@
 """Writing the simkit HDF5 file (schema v1, DESIGN.md): chunked, gzip-compressed, appended in time blocks.
 
-The file is written under a temporary name in the destination folder and renamed only when complete, so an
-interrupted run never leaves a truncated file under the output name.
+Time series are compressed chunk by chunk in a thread pool (byte shuffle + zlib level 1, exactly what HDF5's
+shuffle and deflate filters produce, so any HDF5 reader decodes them) and stored with direct chunk writes:
+zlib releases the GIL, so compression runs beside the simulation. The file is written under a temporary name
+in the destination folder and renamed only when complete, so an interrupted run never leaves a truncated file
+under the output name.
 """
 from __future__ import annotations
 
 import json
 import os
+import zlib
+from concurrent.futures import ThreadPoolExecutor
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -23,15 +28,35 @@ def _chunks(shape, itemsize):
     return (rows,) + tuple(shape[1:])
 
 
+def _shuffle_deflate(chunk: np.ndarray) -> bytes:
+    """The bytes HDF5's shuffle + deflate(level 1) filters make of one full chunk."""
+    raw = np.ascontiguousarray(chunk).view(np.uint8).reshape(-1, chunk.dtype.itemsize)
+    return zlib.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
+
+
+class _Series:
+    """A growing dataset: rows waiting for a full chunk, and chunks being compressed."""
+
+    def __init__(self, ds: h5py.Dataset):
+        self.ds = ds
+        self.rows = ds.chunks[0]
+        self.pending: list[np.ndarray] = []
+        self.n_pending = 0
+        self.n_total = 0
+        self.n_chunks = 0
+
+
 class Writer:
     """Context manager writing one simkit file; ``append`` grows time series block by block."""
 
-    def __init__(self, path: str | Path, attrs: dict, compression: str | None = "gzip"):
+    def __init__(self, path: str | Path, attrs: dict):
         self.path = Path(path)
         self.tmp = self.path.with_name(f".{self.path.name}.tmp-{os.getpid()}")
-        self.compression = compression
         self.attrs = attrs
         self.file: h5py.File | None = None
+        self._series: dict[str, _Series] = {}
+        self._jobs: list = []
+        self._pool = ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1)))
 
     def __enter__(self) -> "Writer":
         self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -46,6 +71,11 @@ class Writer:
 
     def __exit__(self, exc_type, exc, tb):
         try:
+            if exc_type is None:
+                for series in self._series.values():
+                    self._flush(series, final=True)
+                self._drain(0)
+            self._pool.shutdown(wait=True, cancel_futures=True)
             self.file.close()
         finally:
             if exc_type is None:
@@ -54,27 +84,56 @@ class Writer:
                 self.tmp.unlink(missing_ok=True)
         return False
 
-    def _options(self, shape, dtype):
-        opts = dict(chunks=_chunks(shape, np.dtype(dtype).itemsize))
-        if self.compression:
-            opts.update(compression=self.compression, compression_opts=1, shuffle=True)
-        return opts
+    @staticmethod
+    def _options(shape, dtype):
+        return dict(chunks=_chunks(shape, np.dtype(dtype).itemsize), compression="gzip", compression_opts=1,
+                    shuffle=True)
 
     def append(self, name: str, block: np.ndarray, units: str, attrs: dict | None = None) -> None:
         """Append ``block`` along axis 0 of dataset ``name`` (created on first use, resizable)."""
         block = np.asarray(block)
-        f = self.file
-        if name not in f:
+        if name not in self._series:
             shape = (0,) + block.shape[1:]
-            ds = f.create_dataset(name, shape=shape, maxshape=(None,) + block.shape[1:], dtype=block.dtype,
-                                  **self._options((max(1, len(block)),) + block.shape[1:], block.dtype))
+            ds = self.file.create_dataset(name, shape=shape, maxshape=(None,) + block.shape[1:], dtype=block.dtype,
+                                          **self._options((CHUNK_ROWS,) + block.shape[1:], block.dtype))
             ds.attrs["units"] = units
             for k, v in (attrs or {}).items():
                 ds.attrs[k] = v
-        ds = f[name]
-        n = ds.shape[0]
-        ds.resize(n + len(block), axis=0)
-        ds[n:] = block
+            self._series[name] = _Series(ds)
+        series = self._series[name]
+        if block.shape[1:] != series.ds.shape[1:] or block.dtype != series.ds.dtype:
+            raise ValueError(f"{name}: block of shape {block.shape} {block.dtype} does not extend "
+                             f"{series.ds.shape} {series.ds.dtype}")
+        series.pending.append(block.copy())
+        series.n_pending += len(block)
+        series.n_total += len(block)
+        self._flush(series, final=False)
+
+    def _flush(self, series: _Series, final: bool) -> None:
+        """Send every full chunk (and, at the end, the padded last one) to compression."""
+        if series.n_pending == 0 or (series.n_pending < series.rows and not final):
+            return
+        data = np.concatenate(series.pending) if len(series.pending) > 1 else series.pending[0]
+        series.ds.resize(series.n_total, axis=0)
+        start = 0
+        while len(data) - start >= series.rows or (final and start < len(data)):
+            chunk = data[start:start + series.rows]
+            if len(chunk) < series.rows:
+                chunk = np.concatenate([chunk, np.zeros((series.rows - len(chunk),) + chunk.shape[1:], chunk.dtype)])
+            offset = (series.n_chunks * series.rows,) + (0,) * (chunk.ndim - 1)
+            self._jobs.append((series.ds, offset, self._pool.submit(_shuffle_deflate, chunk)))
+            series.n_chunks += 1
+            start += series.rows
+        rest = data[start:]
+        series.pending = [rest] if len(rest) else []
+        series.n_pending = len(rest)
+        self._drain(2 * (os.cpu_count() or 1))
+
+    def _drain(self, keep: int) -> None:
+        """Write finished chunks in order, keeping at most ``keep`` in flight (bounds memory)."""
+        while len(self._jobs) > keep or (self._jobs and self._jobs[0][2].done()):
+            ds, offset, job = self._jobs.pop(0)
+            ds.id.write_direct_chunk(offset, job.result())
 
     def write(self, name: str, data, units: str, attrs: dict | None = None) -> None:
         """Write a whole (small, time-independent) dataset."""
