@@ -18,12 +18,18 @@ def add_parser(sub):
     p.add_argument("file", help="simkit HDF5 file (reads /imu/t and /imu/gyro or /imu/accel)")
     p.add_argument("--sensor", choices=("gyro", "accel"), default="gyro")
     p.add_argument("--gauss-markov", type=int, default=0, metavar="N", help="number of Gauss-Markov terms to fit")
+    p.add_argument("--raw", action="store_true",
+                   help="analyse the raw measurement; by default the truth (/truth/omega_ib_b or /truth/f_ib_b) is "
+                        "subtracted so that vehicle motion does not mask the sensor noise")
     p.add_argument("--plot", metavar="OUT.png", help="save the ADEV plot (needs matplotlib)")
     p.add_argument("--json", metavar="OUT", help="write the fitted terms as JSON")
     return p
 
 
-def _read(path: str, sensor: str):
+TRUTH = {"gyro": "truth/omega_ib_b", "accel": "truth/f_ib_b"}
+
+
+def _read(path: str, sensor: str, raw: bool = False):
     import h5py
 
     try:
@@ -32,6 +38,8 @@ def _read(path: str, sensor: str):
                 raise DataFileError(path, f"no /imu/t and /imu/{sensor} datasets (not a simkit file with IMU data?)")
             t = h5["imu/t"][:]
             y = h5[f"imu/{sensor}"][:]
+            if not raw and TRUTH[sensor] in h5 and h5[TRUTH[sensor]].shape == y.shape:
+                y = y - h5[TRUTH[sensor]][:]
     except OSError as exc:
         raise DataFileError(path, f"cannot read as HDF5 ({exc})") from None
     if t.size < 3 or y.shape != (t.size, 3):
@@ -43,11 +51,12 @@ def _read(path: str, sensor: str):
 def run(args) -> int:
     from ..imu.allan import adev, fit
 
-    dt, y = _read(args.file, args.sensor)
+    dt, y = _read(args.file, args.sensor, args.raw)
     taus, dev, counts = adev(y, dt)
     units = UNITS[args.sensor]
     results = {}
-    print(f"{args.file}: /imu/{args.sensor}, {y.shape[0]} samples at {1 / dt:g} Hz "
+    what = f"/imu/{args.sensor}" + ("" if args.raw else f" - /{TRUTH[args.sensor]}")
+    print(f"{args.file}: {what}, {y.shape[0]} samples at {1 / dt:g} Hz "
           f"(IEEE Std 952 terms, two-sided PSD; bias instability B = ADEV floor / 0.664)")
     print(f"{'axis':>4} " + " ".join(f"{k + ' [' + units[k] + ']':>18}" for k in "QNBKR") + "   Gauss-Markov")
     for a, axis in enumerate("xyz"):
