@@ -1,5 +1,6 @@
 """The bundled LAMBDA ambiguity solver: decorrelation, integer least squares, success rates, validation,
 partial fixing and the baseline-constrained (attitude) solvers. See docs/ambiguity.md."""
+from .constrained import ConstrainedResult, attitude_constrained_ils, baseline_constrained_ils
 from .decorrelation import Decorrelation, decorrelate, ltdl
 from .enumeration import enumerate_ils
 from .errors import AmbiguityInputError
@@ -10,8 +11,9 @@ from .success import (adop, adop_success_rate, adop_upper_bound, bootstrap_succe
 from .validation import DEFAULT_RATIO_THRESHOLD, PartialFix, ffrt, ffrt_threshold, partial_fix, ratio_test
 
 __all__ = [
-    "AmbiguityInputError", "DEFAULT_MAX_NODES", "DEFAULT_RATIO_THRESHOLD", "Decorrelation", "ILSBatchResult",
-    "ILSResult", "PartialFix", "adop", "adop_success_rate", "adop_upper_bound", "bootstrap_success_rate",
+    "AmbiguityInputError", "ConstrainedResult", "DEFAULT_MAX_NODES", "DEFAULT_RATIO_THRESHOLD", "Decorrelation", "ILSBatchResult",
+    "ILSResult", "PartialFix", "adop", "adop_success_rate", "adop_upper_bound", "attitude_constrained_ils",
+    "baseline_constrained_ils", "bootstrap_success_rate",
     "bootstrapping", "decorrelate", "enumerate_ils", "ffrt", "ffrt_threshold", "ils", "ils_batch", "ltdl",
     "monte_carlo_success_rate", "partial_fix", "ratio_test", "rounding", "success_rate_bounds",
 ]

@@ -43,9 +43,19 @@ def _solve_one(a, Qa, bhat, Qb, Qba, mode, F, lengths, m, max_nodes, cands, cost
     if not w[0] > 0.0:
         return -3, -1, -1, 0
     cz = np.zeros((m, n))
-    status, nodes, _ = search_into(zhat, L, d, max_nodes, mode, P, bhat, W, U, w, F, lengths, cz, costs, sols)
+    # search-and-expand: a first leaf far off the constraint would make search-and-shrink start from a huge
+    # ellipsoid, so search below chi2 and expand it until m candidates are inside (then they are the m best)
+    chi2 = float(n + bhat.shape[0])
+    total = 0
+    while True:
+        status, nodes, found = search_into(zhat, L, d, max_nodes - total, mode, P, bhat, W, U, w, F, lengths, cz,
+                                           costs, sols, chi2)
+        total += nodes
+        if found == m or status != OK or total >= max_nodes:
+            break
+        chi2 *= 4.0
     cands[:, :] = back_transform(cz, Zti, shift)
-    return status, 0, 0, nodes
+    return status, 0, 0, total
 
 
 @njit(cache=True)

@@ -37,21 +37,24 @@ def _leaf_cost(mode, dist, zhat, z, P, v, W, U, w, F, lengths, budget, out):
         for i in range(n):
             s += P[k, i] * (zhat[i] - z[i])
         c[k] -= s
-    if mode == MODE_LENGTH:
-        return dist + sphere_fit(c, U, w, lengths[0], out)
-    # cheap lower bound on the attitude misfit: each |R f_j| = l_j, so |c_j - R f_j| >= | |c_j| - l_j |
+    # cheap lower bound of the inner minimum: |x_j| = l_j on the constraint, so |c_j - x_j| >= | |c_j| - l_j |
     lb = 0.0
     for j in range(lengths.shape[0]):
         nj = math.sqrt(c[3 * j] ** 2 + c[3 * j + 1] ** 2 + c[3 * j + 2] ** 2)
         lb += (nj - lengths[j]) ** 2
     if dist + w[0] * lb >= budget:
         return math.inf
+    if mode == MODE_LENGTH:
+        return dist + sphere_fit(c, U, w, lengths[0], out)
     return dist + rotation_fit(c, W, F, out)
 
 
 @njit(cache=True)
-def search_into(zhat, L, d, max_nodes, mode, P, v, W, U, w, F, lengths, cands, costs, sols):
+def search_into(zhat, L, d, max_nodes, mode, P, v, W, U, w, F, lengths, cands, costs, sols, chi2_start=math.inf):
     """Search-and-shrink for the ``m = cands.shape[0]`` best integer vectors of the decorrelated problem.
+
+    Only costs below ``chi2_start`` are searched for (the search-and-expand strategy reruns with a larger one
+    when fewer than m were found).
 
     Fills ``cands`` (m, n) float (integer-valued, sorted by cost), ``costs`` (m,) and, for the constrained modes,
     ``sols`` (m, k) with the inner solution of each candidate. Returns (status, nodes, n_found).
@@ -67,7 +70,7 @@ def search_into(zhat, L, d, max_nodes, mode, P, v, W, U, w, F, lengths, cands, c
         costs[i] = math.inf
     found = 0
     worst = 0
-    chi2 = math.inf
+    chi2 = chi2_start
     k = n - 1
     zc[k] = zhat[k]
     z[k] = math.floor(zc[k] + 0.5)
