@@ -108,7 +108,7 @@ def test_multivariate_attitude_solver():
     assert ok.mean() >= 0.9 and ok.mean() > ok_plain.mean() + 0.3
     err = [np.degrees(np.linalg.norm(Rotation.from_matrix(Rf @ Rt.T).as_rotvec()))
            for Rf, Rt in zip(res.rotations[ok, 0], R_true[ok])]
-    assert max(err) < 1.0  # mm-level carrier on 1-1.5 m baselines
+    assert max(err) < 2.0  # DD carrier sigma 6 mm on 1-1.5 m baselines: ~0.3-0.4 deg per axis (1 sigma)
     np.testing.assert_allclose(res.baselines[ok, 0], res.rotations[ok, 0] @ F)
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .decorrelation import OK, as_problem, raise_for_status
+from .decorrelation import OK, as_problem
 from .errors import AmbiguityInputError
 from .search import DEFAULT_MAX_NODES, MODE_ATTITUDE, MODE_LENGTH, back_transform, prepare, search_into
 
@@ -130,7 +130,7 @@ def _run(a_hat, Qa, b_hat, Qb, Qba, mode, F, lengths, n_cands, max_nodes):
     if err[0] >= 0:
         if err[1] < 0:
             raise AmbiguityInputError(f"Qb[{err[0]}]", "conditional baseline covariance is not positive definite")
-        raise_for_status(int(status[err[0]]), int(err[1]), int(err[2]), what=f"Qa[{int(err[0])}]")
+        raise AmbiguityInputError(f"Qa[{int(err[0])}]", "not symmetric positive definite (or a_hat not finite)")
     finished = status == OK
     if mode == MODE_LENGTH:
         res = ConstrainedResult(cands, costs, finished, nodes, sols)

@@ -126,8 +126,14 @@ def reduce_into(L, d, Z, Zti):
             i -= 1
 
 
-def raise_for_status(code: int, i: int, j: int, what: str = "Q") -> None:
-    """Turn a kernel error code into :class:`AmbiguityInputError` naming the element at fault."""
+def raise_for_status(code: int, i: int, j: int, what: str = "") -> None:
+    """Turn a kernel error code into :class:`AmbiguityInputError` naming the element at fault.
+
+    ``what`` is a suffix naming the epoch of a batch (``"[3]"``); ``i = -1`` points at element ``j`` of a_hat.
+    """
+    if code == ERR_NONFINITE and i < 0:
+        raise AmbiguityInputError(f"a_hat{what}", f"element {j} is NaN or infinite; expected finite floats")
+    what = f"Q{what}"
     if code == ERR_NONFINITE:
         raise AmbiguityInputError(what, f"element [{i}, {j}] is not finite; expected a finite covariance matrix")
     if code == ERR_ASYMMETRIC:

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .decorrelation import (ERR_NOT_PD, NOT_FINISHED, OK, as_problem, check_matrix, ltdl_into,
+from .decorrelation import (ERR_NONFINITE, ERR_NOT_PD, NOT_FINISHED, OK, as_problem, check_matrix, ltdl_into,
                             raise_for_status, reduce_into)
 from .errors import AmbiguityInputError
 from .inner import rotation_fit, sphere_fit
@@ -140,6 +140,9 @@ def prepare(a, Q, L, d, Z, Zti, zhat):
     """Check, factorise and decorrelate; fill zhat = Z^T (a - shift). Returns (code, i, j, shift (n,) int64)."""
     n = a.shape[0]
     shift = np.empty(n, dtype=np.int64)
+    for r in range(n):
+        if not math.isfinite(a[r]):
+            return ERR_NONFINITE, -1, r, shift
     code, i, j = check_matrix(Q)
     if code != OK:
         return code, i, j, shift
@@ -282,7 +285,11 @@ def ils(a_hat, Q, n_cands=2, max_nodes=DEFAULT_MAX_NODES) -> ILSResult:
     non-positive-definite ``Q``.
     """
     _check_counts(n_cands, max_nodes)
-    a, Qm = as_problem(a_hat, Q)
+    a, Qm = a_hat, Q
+    if not (type(a) is np.ndarray and type(Qm) is np.ndarray and a.dtype == np.float64 and Qm.dtype == np.float64
+            and a.ndim == 1 and a.size and Qm.shape == (a.size, a.size) and a.flags.c_contiguous
+            and Qm.flags.c_contiguous):
+        a, Qm = as_problem(a_hat, Q)  # converts, or raises naming the wrong shape
     code, i, j, cands, costs, Z, Zti, L, d, zhat, shift, nodes, _ = _ils_kernel(a, Qm, int(n_cands),
                                                                                 int(max_nodes), _E1, _E2)
     if code < 0:
@@ -323,12 +330,9 @@ def ils_batch(a_hat, Q, n_cands=2, max_nodes=DEFAULT_MAX_NODES):
         Qs = Qs[None]
     if Qs.shape[1:] != (A.shape[1], A.shape[1]) or Qs.shape[0] not in (1, A.shape[0]):
         raise AmbiguityInputError("Q", f"shape {Qs.shape}; expected {(A.shape[0], A.shape[1], A.shape[1])}")
-    bad = ~np.isfinite(A).all(axis=1)
-    if bad.any():
-        raise AmbiguityInputError(f"a_hat[{int(np.argmax(bad))}]", "contains NaN or infinity")
     cands, costs, status, nodes, d, err = _ils_batch_kernel(A, Qs, int(n_cands), int(max_nodes), _E1, _E2)
     if err[0] >= 0:
-        raise_for_status(int(status[err[0]]), int(err[1]), int(err[2]), what=f"Q[{int(err[0])}]")
+        raise_for_status(int(status[err[0]]), int(err[1]), int(err[2]), what=f"[{int(err[0])}]")
     return ILSBatchResult(cands, costs, status == OK, nodes, d)
 
 
@@ -344,7 +348,7 @@ def _ils_list(a_list, Q_list, n_cands, max_nodes):
         Qs = np.stack([probs[k][1] for k in idx])
         cands, costs, status, _, _, err = _ils_batch_kernel(A, Qs, n_cands, max_nodes, _E1, _E2)
         if err[0] >= 0:
-            raise_for_status(int(status[err[0]]), int(err[1]), int(err[2]), what=f"Q[{int(idx[err[0]])}]")
+            raise_for_status(int(status[err[0]]), int(err[1]), int(err[2]), what=f"[{int(idx[err[0]])}]")
         for r, k in enumerate(idx):
             out[k] = (cands[r], costs[r], bool(status[r] == OK))
     return out

@@ -1,0 +1,55 @@
+"""Per-solve time of simkit.ambiguity.ils vs RTKLIB's C lambda (pyrtklib) and cssrlib's Python mlambda.
+
+Run: python benchmarks/bench_lambda.py. Same random problems (simkit.ambiguity.problems.random_problem, "well"
+conditioned, i.e. GNSS-like after a few epochs) for every solver; RTKLIB is timed on pre-filled buffers; medians
+over problems of the per-problem mean time.
+"""
+import os
+import time
+
+import numpy as np
+
+from simkit.ambiguity import ils
+from simkit.ambiguity.problems import random_problem
+
+
+def _time(fn, reps):
+    t = time.perf_counter()
+    for _ in range(reps):
+        fn()
+    return (time.perf_counter() - t) / reps
+
+
+def main(sizes=(10, 20, 40), n_problems=30):
+    import pyrtklib
+    from cssrlib.mlambda import mlambda
+
+    rtk = getattr(pyrtklib, "lambda")
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    saved = os.dup(2)
+    print(f"{'n':>3} {'simkit us':>10} {'RTKLIB C us':>12} {'cssrlib us':>11} {'simkit/C':>9} {'cssrlib/simkit':>15}")
+    for n in sizes:
+        rng = np.random.default_rng(n)
+        ts, tr, tc = [], [], []
+        A = pyrtklib.Arr1Ddouble
+        ab, Qb, F, s = A(n), A(n * n), A(2 * n), A(2)
+        for _ in range(n_problems):
+            a, Q, _ = random_problem(rng, n, "well")
+            ils(a, Q)
+            ts.append(_time(lambda: ils(a, Q, n_cands=2), 200))
+            for i, v in enumerate(a.tolist()):
+                ab[i] = v
+            for i, v in enumerate(Q.T.ravel().tolist()):
+                Qb[i] = v
+            os.dup2(devnull, 2)  # RTKLIB prints loop-count overflows to C stderr
+            try:
+                tr.append(_time(lambda: rtk(n, 2, ab, Qb, F, s), 200))
+            finally:
+                os.dup2(saved, 2)
+            tc.append(_time(lambda: mlambda(a, Q, 2), 2 if n >= 20 else 5))
+        ms, mr, mc = (np.median(x) * 1e6 for x in (ts, tr, tc))
+        print(f"{n:>3} {ms:>10.1f} {mr:>12.1f} {mc:>11.0f} {ms / mr:>9.2f} {mc / ms:>15.0f}")
+
+
+if __name__ == "__main__":
+    main()
