@@ -29,17 +29,21 @@ def empty_table(n: int) -> np.ndarray:
     return np.zeros((n, len(FIELDS)))
 
 
-@numba.njit(cache=True, fastmath=False)
+@numba.njit(cache=True, parallel=True)
 def _propagate(params, idx, t, want_vel, pos, clk, vel, drift):
     c_tilt = math.cos(GEO_TILT)
     s_tilt = math.sin(GEO_TILT)
-    for k in range(idx.shape[0]):
+    for k in numba.prange(idx.shape[0]):  # independent elements: results do not depend on the thread count
         r_i = idx[k]
         if r_i < 0:
-            pos[k, 0] = pos[k, 1] = pos[k, 2] = np.nan
+            pos[k, 0] = np.nan
+            pos[k, 1] = np.nan
+            pos[k, 2] = np.nan
             clk[k] = np.nan
             if want_vel:
-                vel[k, 0] = vel[k, 1] = vel[k, 2] = np.nan
+                vel[k, 0] = np.nan
+                vel[k, 1] = np.nan
+                vel[k, 2] = np.nan
                 drift[k] = np.nan
             continue
         p = params[r_i]

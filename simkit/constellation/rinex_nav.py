@@ -20,7 +20,7 @@ from ..errors import DataFileError
 from . import kepler
 from .model import GroupDelays, KeplerConstellation, Klobuchar, Records
 from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M, SYSTEMS
-from .textfile import number, read_lines
+from .textfile import lines_of, number, read_bytes
 
 N_FIELDS = 31  # af0 af1 af2 + 7 lines x 4 broadcast-orbit values
 _GPS_DAY0 = date(1980, 1, 6).toordinal()
@@ -92,28 +92,68 @@ def _header(lines, path):
     raise DataFileError(path, "no 'END OF HEADER' line: truncated header", len(lines))
 
 
-def _rinex3_blocks(lines, start, path):
-    """Yield (first line number, kind, block lines) for every GPS/BDS record of a RINEX 3 body."""
-    n = len(lines)
-    i = start
-    while i < n:
-        line = lines[i]
-        if not line.strip():
-            i += 1
-            continue
-        if line[0] == " ":
-            raise DataFileError(path, "expected a record start (satellite id in column 1)", i + 1)
-        j = i + 1
-        while j < n and (not lines[j] or lines[j][0] == " "):
-            j += 1
-        block = lines[i:j]
-        if len(block) not in _RINEX3_LINES.get(line[0], (len(block),)):
-            raise DataFileError(path, f"record for {line[:3].strip()} starting here has {len(block)} lines, "
-                                f"expected {' or '.join(map(str, _RINEX3_LINES[line[0]]))} (truncated or malformed)",
-                                i + 1)
-        if line[0] in "GC":
-            yield i + 1, "", block
-        i = j
+def _rinex3_records(buf: np.ndarray, nl: np.ndarray, start: int, lines_total: int, path):
+    """Vectorised RINEX 3 body reader on the raw bytes ``buf`` (uint8) with newline offsets ``nl``.
+
+    Checks every record's line count, then returns (0-based line numbers of the GPS/BDS record starts,
+    (R, 31) values). ``start`` is the first body line. A bad field makes the per-record reader name its line.
+    """
+    line_start = np.concatenate(([0], nl + 1))[: nl.size + 1]
+    line_end = np.append(nl, buf.size)
+    end = lines_total
+    first = np.where(line_end > line_start, buf[np.minimum(line_start, buf.size - 1)], 32)
+    first = np.where(np.isin(first, (10, 13)), 32, first)
+    blank_line = line_end - line_start == 0
+    while end > start and (blank_line[end - 1] or first[end - 1] == 32 and _is_blank(buf, line_start[end - 1],
+                                                                                      line_end[end - 1])):
+        end -= 1
+    body_first = first[start:end]
+    starts = np.flatnonzero(body_first != 32)
+    if end > start and (starts.size == 0 or starts[0] != 0):
+        raise DataFileError(path, "expected a record start (satellite id in column 1)", start + 1)
+    lengths = np.diff(np.append(starts, end - start))
+    sys = body_first[starts]
+    for code, allowed in _RINEX3_LINES.items():
+        bad = (sys == ord(code)) & ~np.isin(lengths, allowed)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            i = start + starts[k]
+            sat = bytes(buf[line_start[i]:line_start[i] + 3]).decode("latin-1").strip()
+            raise DataFileError(path, f"record for {sat} starting here has {lengths[k]} lines, "
+                                f"expected {' or '.join(map(str, allowed))} (truncated or malformed)", i + 1)
+    rec = start + starts[(sys == ord("G")) | (sys == ord("C"))]
+    if rec.size == 0:
+        return rec, np.zeros((0, N_FIELDS))
+    rows = rec[:, None] + _SLOT_LINE[None, :]  # (R, 31) line numbers
+    col0 = line_start[rows] + _SLOT_COL[None, :]
+    pos = col0[..., None] + np.arange(19)  # (R, 31, 19) byte offsets
+    inside = pos < line_end[rows][..., None]
+    chars = np.where(inside, buf[np.minimum(pos, buf.size - 1)], 32).astype(np.uint8)
+    chars[(chars == ord("D")) | (chars == ord("d"))] = ord("E")
+    chars[chars == 13] = 32
+    blank = (chars == 32).all(axis=-1)
+    chars[blank, :3] = np.frombuffer(b"nan", np.uint8)
+    try:
+        vals = chars.reshape(-1, 19).view("S19").ravel().astype(float).reshape(rec.size, N_FIELDS)
+    except ValueError:
+        vals = None
+    if vals is None or (blank & _REQUIRED_MASK).any():
+        text = bytes(buf).decode("latin-1").splitlines()
+        for i in rec:  # raises with the line of the first bad field
+            _values(text[i:i + 8], path, i + 1)
+    vals[blank] = 0.0
+    return rec, vals
+
+
+def _is_blank(buf, a, b) -> bool:
+    return not bytes(buf[a:b]).strip()
+
+
+# (line within the record, first column) of the 31 values of a GPS/BDS record
+_SLOTS = [(0, 23), (0, 42), (0, 61)] + [(j, 4 + 19 * k) for j in range(1, 8) for k in range(4)]
+_SLOT_LINE = np.array([j for j, _ in _SLOTS])
+_SLOT_COL = np.array([c for _, c in _SLOTS])
+_REQUIRED_MASK = np.isin(np.arange(N_FIELDS), list(_REQUIRED))
 
 
 def _rinex4_blocks(lines, start, path):
@@ -134,16 +174,26 @@ def _rinex4_blocks(lines, start, path):
         i = j
 
 
-def read(path) -> KeplerConstellation:
-    """Parse a RINEX 3.0x/4.00 navigation file (plain or gzip) into a broadcast-ephemeris constellation."""
-    lines = read_lines(path)
-    start, version, klob = _header(lines, path)
+def read(path, raw: bytes | None = None) -> KeplerConstellation:
+    """Parse a RINEX 3.0x/4.00 navigation file (plain or gzip; or its already-read content ``raw``) into a
+    broadcast-ephemeris constellation."""
+    raw = read_bytes(path) if raw is None else raw
+    head_end = raw.find(b"END OF HEADER")
+    head_end = len(raw) if head_end < 0 else raw.find(b"\n", head_end) + 1 or len(raw)
+    start, version, klob = _header(lines_of(raw[:head_end]) + [""], path)
     ids, vals, delays = [], [], []
     if version < 4.0:
-        for ln, _, block in _rinex3_blocks(lines, start, path):
-            ids.append(_sat_id(block[0][:3]))
-            vals.append(np.append(_values(block, path, ln), _epoch_seconds(block[0][4:23], path, ln)))
+        buf = np.frombuffer(raw, np.uint8)
+        nl = np.flatnonzero(buf == 10)
+        n_lines = nl.size + (1 if buf.size and buf[-1] != 10 else 0)
+        rec, values = _rinex3_records(buf, nl, start, n_lines, path)
+        line_start = np.concatenate(([0], nl + 1))
+        heads = [raw[a:a + 23].decode("latin-1") for a in line_start[rec]]
+        ids = [_sat_id(h[:3]) for h in heads]
+        toc = np.array([_epoch_seconds(h[4:23], path, i + 1) for h, i in zip(heads, rec)])
+        vals = np.column_stack([values, toc]) if rec.size else []
     else:
+        lines = lines_of(raw)
         for ln, head, block in _rinex4_blocks(lines, start, path):
             parts = head[1:].split()
             if len(parts) < 3:

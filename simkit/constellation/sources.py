@@ -45,11 +45,12 @@ def load(source, *, validity_days: float | None = None) -> Constellation:
         return nominal(text.split(":", 1)[1])
     path = resolve(source)
     from . import almanac, rinex_nav, tle
-    from .textfile import read_lines
+    from .textfile import lines_of, read_bytes
 
-    lines = read_lines(path)
-    if rinex_nav.is_rinex_nav(lines):
-        return rinex_nav.read(path)
+    raw = read_bytes(path)
+    if rinex_nav.is_rinex_nav(lines_of(raw[:200])):
+        return rinex_nav.read(path, raw)
+    lines = lines_of(raw)
     kw = {} if validity_days is None else {"validity_days": validity_days}
     if almanac.is_yuma(lines):
         return almanac.read_yuma(path, lines, **kw)

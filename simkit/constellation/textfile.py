@@ -7,8 +7,8 @@ from pathlib import Path
 from ..errors import DataFileError
 
 
-def read_lines(path) -> list[str]:
-    """All lines of a text file (``.gz`` or plain), without line ends; undecodable bytes become U+FFFD."""
+def read_bytes(path) -> bytes:
+    """The content of a file, gunzipped when it is gzip data (whatever its name)."""
     path = Path(path)
     try:
         raw = path.read_bytes()
@@ -19,7 +19,17 @@ def read_lines(path) -> list[str]:
             raw = gzip.decompress(raw)
         except (OSError, EOFError) as exc:
             raise DataFileError(path, f"corrupt or truncated gzip data ({exc})") from None
+    return raw
+
+
+def lines_of(raw: bytes) -> list[str]:
+    """Text lines of file content (Latin-1, so any byte decodes), without line ends."""
     return raw.decode("latin-1").splitlines()
+
+
+def read_lines(path) -> list[str]:
+    """All lines of a text file (``.gz`` or plain), without line ends."""
+    return lines_of(read_bytes(path))
 
 
 def number(text: str, path, line: int, what: str, blank=0.0) -> float:
