@@ -169,3 +169,11 @@ def test_nominal_bds_geo_fixed_igso_crossing_and_walker():
     np.testing.assert_allclose(np.degrees(np.arccos(h[:, 2] / np.linalg.norm(h, axis=1))), 55.0, atol=1e-9)
     r = np.linalg.norm(pos[meo], axis=1)
     np.testing.assert_allclose(r, 6378137.0 + 21528e3, rtol=1e-12)
+
+
+def test_almanac_source_name_derives_from_the_middle_of_the_file():
+    a = load("almanac:BRDC00WRD_U_20161580000_01D_MN.rnx.gz", validity_days=200)
+    assert a.kind == "almanac" and "C01" in a.sat_ids and "G01" in a.sat_ids
+    assert a.orbit_type[a.sat_ids.index("C01")] == "GEO"
+    p, _ = a.state(1922, 180017.0)  # 2016-11-08 02:00 UTC, the Wang 2018 field test: 5 months out
+    assert np.isfinite(p).all()

@@ -33,12 +33,22 @@ def load(source, *, validity_days: float | None = None) -> Constellation:
     """Load a constellation.
 
     ``source``: ``nominal:gps``, ``nominal:bds`` (= ``nominal:bds3``), ``nominal:bds2``, ``nominal:bds3``,
-    ``nominal:gps+bds``; a file path; or a bundled file name. Files: RINEX 3.0x/4.00 navigation (plain or .gz),
+    ``nominal:gps+bds``; a file path; a bundled file name; or ``almanac:<RINEX nav source>`` (an almanac derived
+    from the broadcast records nearest the middle of the file, see :func:`almanac.from_ephemeris`). Files: RINEX 3.0x/4.00 navigation (plain or .gz),
     YUMA or SEM GPS almanacs, TLE sets (2- or 3-line). ``validity_days`` (almanac and TLE sources only) is the
     span either side of the almanac/TLE epoch in which states are returned (default 7 days); broadcast
     ephemerides always use their fit interval (GPS +-2 h, BDS +-1 h).
     """
     text = str(source)
+    if text.startswith("almanac:"):
+        from . import almanac, kepler
+
+        eph = load(text.split(":", 1)[1])
+        if eph.kind != "broadcast":
+            raise DataFileError(text, "almanac:<source> needs a broadcast-ephemeris (RINEX navigation) source")
+        toe = eph.records.params[eph.records.healthy, kepler.COL["toe"]]
+        mid = 0.5 * (toe.min() + toe.max())
+        return almanac.from_ephemeris(eph, eph.ref_week, mid, validity_days or almanac.DEFAULT_VALIDITY_DAYS)
     if text.startswith("nominal:"):
         from .nominal import nominal
 
