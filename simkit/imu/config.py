@@ -50,6 +50,7 @@ class SensorSpec:
     g_sensitivity: float = 0.0           # gyro only: rad/s per m/s^2, 1-sigma of each of the 9 elements
     range: float = 0.0                   # full scale, rad/s | m/s^2 (0: no saturation)
     bandwidth_hz: float = 0.0            # 2nd-order Butterworth -3 dB frequency (0: unlimited)
+    vibration_psd: tuple[tuple[float, float], ...] = ()  # ONE-sided PSD table (Hz, (rad/s)^2/Hz | (m/s^2)^2/Hz)
 
     @property
     def is_ideal(self) -> bool:
@@ -109,6 +110,9 @@ _ACCEL_KEYS = {
 # [[imu.<sensor>.gauss_markov]] tables: sigma key and its factor to SI
 _GM_SIGMA = {"gyro": ("sigma_deg_per_h", DEG / HOUR), "accel": ("sigma_ug", 1e-6 * G0)}
 SENSOR_KEYS = {"gyro": _GYRO_KEYS, "accel": _ACCEL_KEYS}
+# Vibration PSD table key (pairs [f_hz, one-sided psd]) and the factor of its PSD column to SI
+VIBRATION_KEYS = {"gyro": ("vibration_psd_deg2_per_s2_per_hz", DEG * DEG),
+                  "accel": ("vibration_psd_g2_per_hz", G0 * G0)}
 
 
 def presets() -> list[str]:
@@ -135,6 +139,22 @@ def _merge(base: dict, over: dict) -> dict:
     return out
 
 
+def _vibration_table(sec: Section, name: str) -> tuple[tuple[float, float], ...]:
+    """The [[f_hz, psd], ...] table of ``name``'s vibration key, PSD in SI; checked pairs, f and PSD > 0, f rising."""
+    key, factor = VIBRATION_KEYS[name]
+    table = sec.get(key, list, [])
+    if not table:
+        return ()
+    if len(table) < 2 or not all(isinstance(p, list) and len(p) == 2 and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in p) for p in table):
+        raise sec.error(key, f"expected an array of at least 2 [f_hz, psd] pairs of finite numbers, got {table!r}")
+    if not all(f > 0 and s > 0 for f, s in table):
+        raise sec.error(key, f"frequencies and PSD values must be > 0, got {table!r}")
+    if not all(a[0] < b[0] for a, b in zip(table, table[1:])):
+        raise sec.error(key, f"frequencies must be strictly increasing, got {table!r}")
+    return tuple((float(f), float(s) * factor) for f, s in table)
+
+
 def _parse_sensor(sec: Section, name: str) -> SensorSpec:
     values = {}
     for key, (attr, factor) in SENSOR_KEYS[name].items():
@@ -148,6 +168,7 @@ def _parse_sensor(sec: Section, name: str) -> SensorSpec:
         gms.append(GaussMarkov(gm.get(sigma_key, float, check=non_negative) * factor,
                                gm.get("tau_s", float, check=positive)))
         gm.done()
+    values["vibration_psd"] = _vibration_table(sec, name)
     sec.done()
     spec = SensorSpec(gauss_markov=tuple(gms), **values)
     if spec.bias_instability_tau_min_s >= spec.bias_instability_tau_max_s:

@@ -2,6 +2,7 @@
 
 Per sensor, in this order (body frame x right, y forward, z up):
   signal  = x + (S + M) x + nonlinearity(x) [+ G f for the gyro]        scale factor, misalignment, g-sensitivity
+            + vibration                                                 random vibration from a PSD table
   sensed  = lowpass(signal)                                             bandwidth (2nd-order Butterworth)
   y       = sensed + bias + white                                       bias = turn-on + flicker + RRW + Gauss-Markov
   y_sat   = clip(y, -range, range)                                      saturation
@@ -15,8 +16,9 @@ import math
 import numpy as np
 
 from ..rng import generator
-from .config import ImuConfig, SensorSpec
+from .config import VIBRATION_KEYS, ImuConfig, SensorSpec
 from .noise import Flicker, GaussMarkov, LowPass, Quantizer, RandomWalk, WhiteNoise
+from .vibration import Vibration
 
 
 class ImuBlock(tuple):
@@ -85,6 +87,8 @@ class _Sensor:
             if gm.sigma > 0:
                 self.bias_sources.append(GaussMarkov(gm.sigma, gm.tau_s, dt, rng("gauss_markov", str(i))))
         self.white = WhiteNoise(s.random_walk, dt, rng("white")) if s.random_walk > 0 else None
+        self.vibration = (Vibration(np.array(s.vibration_psd), dt, rng("vibration"),
+                                    f"imu.{name}.{VIBRATION_KEYS[name][0]}") if s.vibration_psd else None)
         nyquist = 0.5 / dt
         self.lowpass = LowPass(s.bandwidth_hz, dt) if 0 < s.bandwidth_hz < nyquist else None
         self.quantizer = Quantizer(s.quantization) if s.quantization > 0 else None
@@ -103,6 +107,9 @@ class _Sensor:
         if self.g_matrix is not None:
             errors["g_sensitivity"] = _apply(self.g_matrix, f)
             signal = signal + errors["g_sensitivity"]
+        if self.vibration is not None:
+            errors["vibration"] = self.vibration.block(n)
+            signal = signal + errors["vibration"]
         y = signal
         if self.lowpass is not None:
             y = self.lowpass.block(signal)
