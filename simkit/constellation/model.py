@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import gpstime
 from . import kepler
-from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M, SYSTEMS
+from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M
 
 SECONDS_PER_WEEK = gpstime.SECONDS_PER_WEEK
 
@@ -195,16 +195,3 @@ class KeplerConstellation(Constellation):
     def _evaluate(self, t, velocity):
         idx, t_eval = self.select(t)
         return kepler.propagate(self.records.params, idx.ravel(), t_eval.ravel(), velocity)
-
-    def orbit_params(self, gps_week, gps_sow) -> tuple[np.ndarray, np.ndarray]:
-        """The record (row of ``records.params``, columns ``kepler.FIELDS``) used per epoch and satellite:
-        returns (idx (T + (S,)) int, -1 where none; params table)."""
-        shape, t = self._seconds(gps_week, gps_sow)
-        s = len(self.sat_ids)
-        idx = self.select(np.broadcast_to(t[:, None], (t.size, s)))[0]
-        return idx.reshape(shape + (s,)), self.records.params
-
-
-def system_of(sat_id: str):
-    """The :class:`~simkit.constellation.systems.System` of a satellite id ("G05" -> GPS)."""
-    return SYSTEMS[sat_id[0]]

@@ -27,10 +27,6 @@ def lines_of(raw: bytes) -> list[str]:
     return raw.decode("latin-1").splitlines()
 
 
-def read_lines(path) -> list[str]:
-    """All lines of a text file (``.gz`` or plain), without line ends."""
-    return lines_of(read_bytes(path))
-
 
 def number(text: str, path, line: int, what: str, blank=0.0) -> float:
     """One Fortran-style number (D or E exponent); ``blank`` when the field is empty (None: empty is an error)."""
