@@ -12,7 +12,7 @@ import sys
 from . import __version__
 from .errors import SimkitError
 
-COMMANDS = ("run", "inspect", "allan", "rinex")
+COMMANDS = ("run", "inspect", "allan", "sky", "rinex")
 
 
 def build_parser() -> argparse.ArgumentParser:
