@@ -1,8 +1,9 @@
 """Writing the simkit HDF5 file (schema v1, DESIGN.md): chunked, gzip-compressed, appended in time blocks.
 
-Time series are compressed chunk by chunk in a thread pool (byte shuffle + zlib level 1, exactly what HDF5's
-shuffle and deflate filters produce, so any HDF5 reader decodes them) and stored with direct chunk writes:
-zlib releases the GIL, so compression runs beside the simulation. The file is written under a temporary name
+Time series are compressed chunk by chunk in a thread pool (byte shuffle + deflate level 1 in zlib format, which
+is what HDF5's shuffle and deflate filters read, so any HDF5 reader decodes them) and stored with direct chunk
+writes. Deflate is ISA-L's (``isal``): the same format at about 13x zlib's speed; it releases the GIL, so
+compression runs beside the simulation. The file is written under a temporary name
 in the destination folder and renamed only when complete, so an interrupted run never leaves a truncated file
 under the output name.
 """
@@ -10,13 +11,13 @@ from __future__ import annotations
 
 import json
 import os
-import zlib
 from concurrent.futures import ThreadPoolExecutor
 from datetime import datetime, timezone
 from pathlib import Path
 
 import h5py
 import numpy as np
+from isal import isal_zlib
 
 from .. import SCHEMA_VERSION, __version__
 
@@ -31,7 +32,7 @@ def _chunks(shape, itemsize):
 def _shuffle_deflate(chunk: np.ndarray) -> bytes:
     """The bytes HDF5's shuffle + deflate(level 1) filters make of one full chunk."""
     raw = np.ascontiguousarray(chunk).view(np.uint8).reshape(-1, chunk.dtype.itemsize)
-    return zlib.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
+    return isal_zlib.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
 
 
 class _Series:
