@@ -20,18 +20,13 @@ from numba import njit
 
 from .decorrelation import OK, as_problem
 from .errors import AmbiguityInputError
-from .search import DEFAULT_MAX_NODES, MODE_ATTITUDE, MODE_LENGTH, back_transform, prepare, search_into
+from .search import DEFAULT_MAX_NODES, MODE_ATTITUDE, MODE_LENGTH, back_transform, prepare_new, search_into
 
 
 @njit(cache=True)
 def _solve_one(a, Qa, bhat, Qb, Qba, mode, F, lengths, m, max_nodes, cands, costs, sols):
     n = a.shape[0]
-    L = np.empty((n, n))
-    d = np.empty(n)
-    Z = np.empty((n, n), dtype=np.int64)
-    Zti = np.empty((n, n), dtype=np.int64)
-    zhat = np.empty(n)
-    code, i, j, shift = prepare(a, Qa, L, d, Z, Zti, zhat)
+    code, i, j, shift, L, d, Z, Zti, zhat = prepare_new(a, Qa)
     if code != OK:
         return code, i, j, 0
     K = np.linalg.solve(Qa, Qba.T).T  # Qba Qa^-1, (p, n)

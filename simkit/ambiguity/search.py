@@ -183,7 +183,8 @@ _E2 = np.empty((0, 0))
 
 
 @njit(cache=True)
-def _ils_kernel(a, Q, m, max_nodes, e1, e2):
+def prepare_new(a, Q):
+    """:func:`prepare` into freshly allocated work arrays; returns (code, i, j, shift, L, d, Z, Zti, zhat)."""
     n = a.shape[0]
     L = np.empty((n, n))
     d = np.empty(n)
@@ -191,6 +192,13 @@ def _ils_kernel(a, Q, m, max_nodes, e1, e2):
     Zti = np.empty((n, n), dtype=np.int64)
     zhat = np.empty(n)
     code, i, j, shift = prepare(a, Q, L, d, Z, Zti, zhat)
+    return code, i, j, shift, L, d, Z, Zti, zhat
+
+
+@njit(cache=True)
+def _ils_kernel(a, Q, m, max_nodes, e1, e2):
+    n = a.shape[0]
+    code, i, j, shift, L, d, Z, Zti, zhat = prepare_new(a, Q)
     cz = np.zeros((m, n))
     costs = np.full(m, math.inf)
     nodes = 0
