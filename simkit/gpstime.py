@@ -71,6 +71,7 @@ def normalize(week, sow):
     week = np.asarray(week)
     sow = np.asarray(sow, dtype=float)
     carry = np.floor(sow / SECONDS_PER_WEEK)
+    carry = np.where(np.isfinite(carry), carry, 0.0)  # a NaN time stays NaN in sow, its week unchanged
     week = week + carry.astype(np.int64)
     sow = sow - carry * SECONDS_PER_WEEK
     if week.ndim == 0:

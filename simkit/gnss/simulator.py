@@ -19,7 +19,6 @@ multipath, ambiguities, slip times, tracking) makes the output independent of th
 from __future__ import annotations
 
 import heapq
-import warnings
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -57,10 +56,8 @@ class _Sky:
 
     def view(self, rx, week, sow):
         parts = []
-        with np.errstate(invalid="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)  # NaN states (no valid record) are expected
-            for c in self.consts:
-                parts.append(receiver_view(c, rx, week, sow, velocity=True))
+        for c in self.consts:
+            parts.append(receiver_view(c, rx, week, sow, velocity=True))
         cat = lambda name: np.concatenate([getattr(p, name) for p in parts], axis=1)  # noqa: E731
         return {k: cat(k) for k in ("sat_pos", "sat_vel", "sat_clock", "sat_drift", "tau", "elevation")}
 
@@ -78,9 +75,7 @@ class _Sky:
         total = len(self.sat_ids)
         for c in self.consts:
             n = len(c.sat_ids)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)
-                gd = c.group_delays(week, sow) if hasattr(c, "group_delays") else {}
+            gd = c.group_delays(week, sow) if hasattr(c, "group_delays") else {}
             for name, vals in gd.items():
                 out.setdefault(name, np.full(total, np.nan))[offset:offset + n] = vals
             offset += n
