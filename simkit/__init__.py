@@ -1,8 +1,9 @@
 """simkit: multi-antenna GNSS/INS simulation with exact truth, and the tools that check what consumes it."""
 from __future__ import annotations
 
-__version__ = "0.1.0"
-SCHEMA_VERSION = 1
+from .version import __version__
+
+__all__ = ["__version__", "open", "run"]
 
 
 def run(scenario, out=None, seed=None, overrides=None, progress=False):

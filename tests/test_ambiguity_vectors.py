@@ -7,9 +7,10 @@ import pytest
 
 from simkit import ambiguity as amb
 
-VECTORS = Path(__file__).resolve().parents[2] / "shared" / "lambda_testvectors.json"
-pytestmark = pytest.mark.skipif(not VECTORS.exists(), reason="shared/lambda_testvectors.json not present")
-DATA = json.loads(VECTORS.read_text()) if VECTORS.exists() else {"cases": {}}
+from conftest import DATA as _DATA_DIR
+
+VECTORS = _DATA_DIR / "lambda_testvectors.json"
+DATA = json.loads(VECTORS.read_text())
 CASES = sorted(DATA["cases"])
 # sqnorm tolerance: 1e-9 relative; the 6- and 12-dimensional covariances (entries ~1e4 cycles^2) are so badly
 # conditioned that float64 arithmetic, ours and the file's alike, lands ~1e-9..6e-9 from the exact (50-digit)

@@ -13,8 +13,10 @@ import pytest
 
 from simkit.constellation import kepler, load
 
-pyrtklib = pytest.importorskip("pyrtklib")
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "rinex_nav"
+import pyrtklib
+from conftest import DATA as _DATA
+
+DATA = _DATA / "rinex_nav"
 GPS_1980_UNIX = 315964800  # RTKLIB gtime_t counts GPST seconds from 1970-01-01
 FILES = ["BRDM00DLR_S_20261170000_01D_MN.rnx.gz", "BRDC00WRD_U_20161580000_01D_MN.rnx", "cubb1870.15c"]
 
@@ -40,8 +42,6 @@ def _sat_id(sat):
 @pytest.mark.parametrize("name", FILES)
 def test_eph2pos_agreement(name, tmp_path):
     src = DATA / name
-    if not src.exists():
-        pytest.skip("shared data not available")
     const = load(src)
     nav = _rtklib_nav(src, tmp_path)
     p = const.records.params

@@ -8,8 +8,7 @@ import pytest
 from simkit import frames
 from simkit.constellation import almanac, load, nominal
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
-needs_shared = pytest.mark.skipif(not SHARED.is_dir(), reason="shared data not available")
+from conftest import DATA as SHARED
 
 
 def _common(a, b):
@@ -17,7 +16,6 @@ def _common(a, b):
     return [a.sat_ids.index(s) for s in ids], [b.sat_ids.index(s) for s in ids]
 
 
-@needs_shared
 def test_rinex4_records_and_bds_orbit_types_match_cnav1_sattype():
     """RINEX 4: every LNAV/D1/D2 record is read; our orbit-based GEO/IGSO/MEO decision equals the satellite
     type broadcast in the same file's BDS CNAV1 records (BO5 field 3: 1 GEO, 2 IGSO, 3 MEO)."""
@@ -44,7 +42,6 @@ def test_rinex4_records_and_bds_orbit_types_match_cnav1_sattype():
     assert set(const.klobuchar) == {"G", "C"}
 
 
-@needs_shared
 def test_space_padded_ids_and_gzip_give_the_same_constellation(tmp_path):
     src = SHARED / "rinex_nav" / "BRDC00WRD_U_20161580000_01D_MN.rnx"
     text = src.read_text()
@@ -58,7 +55,6 @@ def test_space_padded_ids_and_gzip_give_the_same_constellation(tmp_path):
     np.testing.assert_array_equal(a.state(1900, sow)[0], b.state(1900, sow)[0])
 
 
-@needs_shared
 def test_sem_and_yuma_of_the_same_almanac_agree():
     """Orekit's week-862 SEM and YUMA files carry the same almanac: semicircles and the 0.30 sc inclination
     offset (SEM) must give the positions of radians (YUMA) up to the files' rounding."""
@@ -71,7 +67,6 @@ def test_sem_and_yuma_of_the_same_almanac_agree():
     assert len(i) >= 30 and np.nanmax(d) < 1.0
 
 
-@needs_shared
 def test_almanac_10bit_week_resolves_at_any_rollover_and_is_nan_outside_validity():
     alm = load(SHARED / "yuma" / "test_input_yuma377.txt")  # week 377: GPS week 1401 (2006) or 2425 (2026)
     p_2006, _ = alm.state(1401, 319488.0)
@@ -99,7 +94,6 @@ def test_derived_almanac_vs_broadcast_ephemeris_over_a_day():
         assert np.nanmax(d[:, m]) < limit_km * 1e3
 
 
-@needs_shared
 def test_tle_vs_yuma_same_fortnight():
     """CelesTrak TLEs (2022-02-03/04) and the YUMA almanac of 2022-02-17: both propagated to the midpoint."""
     yuma = load(SHARED / "yuma" / "almanac.yuma.week0149.405504.txt", validity_days=20)
@@ -114,7 +108,6 @@ def test_tle_vs_yuma_same_fortnight():
     assert np.nanmedian(out["YUMA toa"]) < 10e3 and np.nanmedian(out["TLE epoch"]) < 20e3
 
 
-@needs_shared
 def test_bds_tle_classifies_geo_igso_meo_like_the_ephemeris():
     tle = load(SHARED / "tle" / "beidou_2022-02-04.txt")
     eph = load("BRDM00DLR_S_20261170000_01D_MN.rnx.gz")

@@ -8,16 +8,16 @@ from simkit import earth, frames
 from simkit.earth import C_LIGHT
 from simkit.errors import ScenarioError
 from simkit.gnss import (GnssSimulator, dd_covariance, double_difference, parse_config, reference_satellites)
-from simkit.scenario.fields import Section
+from simkit.section import Section
 
-SHARED = Path(__file__).resolve().parents[2] / "shared"
-NAV = SHARED / "data" / "rinex_nav" / "BRDC00WRD_U_20161580000_01D_MN.rnx"
+from conftest import DATA
+
+NAV = DATA / "rinex_nav" / "BRDC00WRD_U_20161580000_01D_MN.rnx"
 WEEK, SOW = 1900, 86400.0 + 10 * 3600.0  # 2016-06-06 10:00 GPST, inside the file's records
 ORIGIN = frames.lla_to_ecef(np.radians(34.2), np.radians(108.9), 400.0)
 ALL_OFF = {k: False for k in ("receiver_clock", "satellite_clock", "group_delay", "ionosphere", "troposphere",
                               "multipath", "noise", "cycle_slips")}
 
-needs_nav = pytest.mark.skipif(not NAV.is_file(), reason="shared data folder absent")
 
 
 def make(extra=None, duration=120.0, seed=3, start=(WEEK, SOW)):
@@ -51,7 +51,6 @@ def run(sim, truth=None, blocks=1):
     return {k: np.concatenate([p[k][0] for p in parts]) for k in parts[0]}
 
 
-@needs_nav
 def test_observables_equal_sum_of_truth_terms():
     sim = make({"slip_rate_per_h": 20.0, "clock": "per_antenna"})
     out = run(sim)
@@ -79,7 +78,6 @@ def test_observables_equal_sum_of_truth_terms():
     assert np.ptp(out["truth/receiver_clock"][:, 0] - out["truth/receiver_clock"][:, 1]) > 0  # per-antenna clocks
 
 
-@needs_nav
 @pytest.mark.parametrize("model", ["constant", "cn0"])
 def test_dd_carrier_residuals_have_configured_sigma(model):
     sigma = 0.003
@@ -113,7 +111,6 @@ def test_dd_carrier_residuals_have_configured_sigma(model):
         assert abs(z.std() - 1) < 0.10 and abs(z.mean()) < 0.05
 
 
-@needs_nav
 def test_doppler_matches_time_differenced_carrier_static():
     # quiet: no noise, no multipath, no slips, and an ideal oscillator (a crystal's white-FM phase noise makes
     # the time-differenced carrier differ from the Doppler by c sqrt(h0 / 2 dt), about 0.1 m/s for a TCXO)
@@ -131,7 +128,6 @@ def test_doppler_matches_time_differenced_carrier_static():
         assert np.abs(e).max() < 1e-3
 
 
-@needs_nav
 def test_high_dynamics_doppler_tens_of_khz():
     """Straight line at 7.5 km/s, 10 Hz: Doppler of tens of kHz still equals -d(carrier)/dt."""
     quiet = {**ALL_OFF, "receiver_clock": True, "satellite_clock": True}
@@ -150,7 +146,6 @@ def test_high_dynamics_doppler_tens_of_khz():
     assert np.abs(e).max() < 1e-3
 
 
-@needs_nav
 def test_block_split_gives_identical_arrays_and_seed_determinism():
     extra = {"slip_rate_per_h": 30.0, "slip": [{"t_s": 50.0, "sat": "G01", "cycles": 7}],
              "outage": [{"start_s": 20.0, "end_s": 35.0, "antennas": [1]}]}
@@ -162,7 +157,6 @@ def test_block_split_gives_identical_arrays_and_seed_determinism():
     assert not np.array_equal(a["obs/L1C/code"], c["obs/L1C/code"], equal_nan=True)
 
 
-@needs_nav
 def test_slips_outages_and_lli():
     sim = make({"slip": [{"t_s": 50.0, "sat": "G01", "antenna": 1, "signal": "L1C", "cycles": 7}],
                 "outage": [{"start_s": 20.0, "end_s": 35.0, "antennas": [2], "sats": ["G06"]}]})
@@ -179,7 +173,6 @@ def test_slips_outages_and_lli():
     assert np.all(lli[1:][change] == 1)
 
 
-@needs_nav
 def test_antenna_positions_follow_attitude_and_masking():
     sim = make({"signals": ["L1C"]}, duration=2.0)
     out = run(sim, static_truth(sim.epoch_times(), heading_deg=90.0))

@@ -9,7 +9,7 @@ from simkit.imu import ImuSimulator
 from simkit.imu.allan import FLICKER_FLOOR, adev, fit, gm_avar, gm_peak
 from simkit.imu.config import GaussMarkov, ImuConfig, SensorSpec
 
-allantools = pytest.importorskip("allantools")
+import allantools
 
 
 def gyro_errors(spec: SensorSpec, rate_hz: float, duration_s: float, seed: int = 7, term: str | None = None,

@@ -8,7 +8,7 @@ import pytest
 
 from simkit.errors import ScenarioError
 from simkit.imu import ImuSimulator, parse_config, presets, truth_increments
-from simkit.scenario.fields import Section
+from simkit.section import Section
 
 ALL_TERMS = {
     "preset": "stim300",

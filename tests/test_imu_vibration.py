@@ -9,7 +9,7 @@ from scipy import signal
 from simkit.errors import ScenarioError
 from simkit.imu import ImuSimulator, parse_config
 from simkit.imu.vibration import band_variance
-from simkit.scenario.fields import Section
+from simkit.section import Section
 
 G0 = 9.80665
 RATE = 1000.0

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ScenarioError
-from ..scenario.fields import Section, in_range, non_negative, positive
+from ..section import Section, in_range, non_negative, positive
 from . import clock, signals
 
 ERROR_TERMS = ("receiver_clock", "satellite_clock", "group_delay", "ionosphere", "troposphere", "multipath",

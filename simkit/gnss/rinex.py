@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__, gpstime
+from .. import gpstime
+from ..version import __version__
 from ..earth import C_LIGHT
 from . import signals as sigmod
 

@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass, field
 from importlib import resources
 
 from ..errors import ScenarioError
-from ..scenario.fields import Section, non_negative, positive
+from ..section import Section, non_negative, positive
 
 DEG = math.pi / 180.0
 HOUR = 3600.0

@@ -19,7 +19,8 @@ import h5py
 import numpy as np
 from isal import isal_zlib
 
-from .. import SCHEMA_VERSION, __version__
+from ..version import __version__
+from .schema import SCHEMA_VERSION
 
 CHUNK_ROWS = 1 << 16  # time samples per chunk along the first axis
 

@@ -16,7 +16,10 @@ from typing import Any
 
 from .. import gpstime
 from ..errors import ScenarioError
-from .fields import Section, positive
+from ..gnss import parse_config as parse_gnss
+from ..imu import parse_config as parse_imu
+from ..section import Section, positive
+from ..trajectory import parse_config as parse_trajectory
 
 _INDEX = re.compile(r"^([A-Za-z_][\w-]*)(?:\[(\d+)\])?$")
 
@@ -143,21 +146,15 @@ def _validate(data: dict) -> Scenario:
     meta.done()
     week, sow = gpstime.utc_to_gps(start)
 
-    from ..trajectory import parse_config as parse_trajectory
-
     traj = parse_trajectory(root.section("trajectory", required=True))
     imu = gnss = None
     if root.has("imu"):
-        from ..imu import parse_config as parse_imu
-
         imu = parse_imu(root.section("imu"))
         rate = getattr(imu, "rate_hz", None)
         if rate is not None and abs(rate - traj.rate_hz) > 1e-9:
             raise ScenarioError("imu.rate_hz", f"must equal trajectory.rate_hz ({traj.rate_hz:g}): the truth is "
                                 f"generated at the IMU rate, got {rate:g}")
     if root.has("gnss"):
-        from ..gnss import parse_config as parse_gnss
-
         gnss = parse_gnss(root.section("gnss"))
         ratio = traj.rate_hz / gnss.rate_hz
         if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .. import earth, frames
-from ..scenario.fields import Section, in_range, positive
+from ..section import Section, in_range, positive
 from .segments import G0, KinematicState, plan
 
 CHANNELS = ("accel", "pitch_rate", "turn_rate", "turn_accel", "roll_rate")

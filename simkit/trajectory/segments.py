@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..scenario.fields import Section, positive
+from ..section import Section, positive
 from .profiles import Plateau, Sinusoid
 from .spline import WaypointPath, unit_velocity
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from typing import Any, Callable
 
-from ..errors import ScenarioError
+from .errors import ScenarioError
 
 REQUIRED = object()
 
