@@ -6,11 +6,11 @@ from .version import __version__
 __all__ = ["__version__", "open", "run"]
 
 
-def run(scenario, out=None, seed=None, overrides=None, progress=False):
+def run(scenario, out=None, seed=None, overrides=None, progress=False, force=False):
     """Simulate ``scenario`` (a TOML path, a bundled name or a dict) into an HDF5 file; returns its Path."""
     from .pipeline import run as _run
 
-    return _run(scenario, out=out, seed=seed, overrides=overrides, progress=progress)
+    return _run(scenario, out=out, seed=seed, overrides=overrides, progress=progress, force=force)
 
 
 def open(path):  # noqa: A001 - the documented API name

@@ -1,40 +1,60 @@
 """The ``simkit`` command line: one sub-command per module in :mod:`simkit.commands`.
 
-Bad input ends with one line on stderr (which file, which key or line, what was expected) and a non-zero exit
-code, never a traceback.
+Bad input ends with one line on stderr (which file, which key or line, what was expected) and exit code 2,
+never a traceback. SIGTERM and SIGHUP stop a command like Ctrl-C does (partial outputs are removed); a closed
+output pipe (``simkit inspect f.h5 | head -1``) ends the command quietly.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
+import signal
 import sys
 
-from . import __version__
 from .errors import SimkitError
+from .version import __version__
 
 COMMANDS = ("run", "inspect", "allan", "sky", "rinex")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (exit 2) instead of the usage block."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="simkit", description="Multi-antenna GNSS/INS simulation toolkit.")
+    parser = _Parser(prog="simkit", description="Multi-antenna GNSS/INS simulation toolkit.")
     parser.add_argument("--version", action="version", version=f"simkit {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, parser_class=_Parser)
     for name in COMMANDS:
         module = importlib.import_module(f"simkit.commands.{name}")
         module.add_parser(sub).set_defaults(_run=module.run)
     return parser
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, _interrupt)
     try:
         return int(args._run(args) or 0)
     except SimkitError as exc:
         print(f"simkit {args.command}: error: {exc}", file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
-        print(f"simkit {args.command}: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        print(f"simkit {args.command}: interrupted{f' ({exc})' if str(exc) else ''}", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader went away (| head): stop quietly; point stdout at /dev/null so the final flush cannot raise
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":

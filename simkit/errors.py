@@ -39,3 +39,14 @@ class DataFileError(SimkitError):
         self.path, self.message, self.line = str(path), message, line
         where = f"{self.path}:{line}" if line is not None else self.path
         super().__init__(f"{where}: {message}")
+
+
+class OutputError(SimkitError):
+    """An output cannot be written where asked (missing folder, read-only place, a directory, the input itself),
+    or would not fit: found before any work is done."""
+
+    exit_code = 2
+
+    def __init__(self, path, message: str):
+        self.path, self.message = str(path), message
+        super().__init__(f"{self.path}: {message}")

@@ -1,78 +1,207 @@
-"""``simkit.run``: scenario -> trajectory truth -> IMU -> GNSS observables -> one HDF5 file, block by block."""
+"""``simkit.run``: the one place that wires the stages together.
+
+scenario -> trajectory truth -> IMU -> (sky from the constellation stage) -> GNSS observables -> one HDF5 file,
+block by block. Each stage takes and returns arrays and small dataclasses; this module maps them to the dataset
+paths that ``simkit/io/schema.py`` declares.
+"""
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
 
-from .io.writer import Writer
-from .scenario import load
+from . import gpstime
+from .constellation import Sky, load_sky
+from .errors import DataFileError, OutputError, ScenarioError
+from .gnss import GnssSimulator
+from .imu import ImuSimulator
+from .io import Writer, check_output
+from .scenario import Scenario, load, resolve
 from .trajectory import Trajectory
 
 BLOCK_SAMPLES = 1 << 16
+MAX_OUTPUT_BYTES = 100 * 2**30  # refuse larger runs unless forced: a typo in duration_s, not a dataset
+_SKY_CHECK_STEP_S = 60.0
 
 
-def run(scenario, out=None, seed=None, overrides=None, progress=False, block_samples: int = BLOCK_SAMPLES) -> Path:
-    """Simulate a scenario into ``out`` (default ``<scenario name>.h5``); returns the output path."""
-    sc = load(scenario, overrides)
-    seed = sc.seed if seed is None else int(seed)
+@dataclass(frozen=True)
+class Stages:
+    """The stages of one run, built from a scenario."""
+
+    trajectory: Trajectory
+    imu: ImuSimulator | None
+    gnss: GnssSimulator | None
+
+
+def run(scenario, out=None, seed=None, overrides=None, progress=False, block_samples: int = BLOCK_SAMPLES,
+        force: bool = False) -> Path:
+    """Simulate a scenario into ``out`` (default ``<scenario name>.h5``); returns the output path.
+
+    Everything that can be checked is checked before the first sample: the scenario, the constellation sources
+    and their coverage of the run, the output path, and the output size (refused above the free disk space or
+    :data:`MAX_OUTPUT_BYTES` unless ``force``).
+    """
+    sc = load(scenario, overrides, seed=seed)
+    stages = build(sc)
     out = Path(out) if out is not None else Path(f"{sc.name}.h5")
+    size = estimate_bytes(sc, stages)
+    if size > MAX_OUTPUT_BYTES and not force:
+        raise OutputError(out, f"the run would write about {size / 2**30:.0f} GiB (limit {MAX_OUTPUT_BYTES / 2**30:.0f}"
+                          f" GiB; scenario.duration_s = {sc.duration_s:g}); --force to run it anyway")
+    source = None if isinstance(scenario, dict) else _scenario_file(scenario)
+    check_output(out, inputs=[source], estimated_bytes=size, force=force)
+    with Writer(out, root_attributes(sc)) as w:
+        _write(w, sc, stages, block_samples, progress)
+    return out
+
+
+def build(sc: Scenario) -> Stages:
+    """The stages of scenario ``sc`` (the sky is loaded and checked to cover the run)."""
     traj = Trajectory(sc.trajectory, sc.duration_s)
-    rate = sc.trajectory.rate_hz
-    n_total = traj.n_samples()
-
-    imu = gnss = None
-    if sc.imu is not None:
-        from .imu import ImuSimulator
-
-        imu = ImuSimulator(sc.imu, rate, seed)
+    imu = ImuSimulator(sc.imu, sc.trajectory.rate_hz, sc.seed) if sc.imu is not None else None
+    gnss = None
     if sc.gnss is not None:
-        from .gnss import GnssSimulator
+        origin = next(traj.blocks(block_samples=1)).pos_ecef[0]
+        sky = _sky(sc, origin)
+        gnss = GnssSimulator(sc.gnss, sky, sc.start_week, sc.start_sow, sc.seed, sc.duration_s)
+    return Stages(traj, imu, gnss)
 
-        gnss = GnssSimulator(sc.gnss, sc.start_week, sc.start_sow, seed, sc.duration_s)
-        stride = int(round(rate / sc.gnss.rate_hz))
 
-    attrs = {"scenario_toml": sc.text, "seed": seed, "start_gps_week": sc.start_week,
-             "start_gps_sow": sc.start_sow, "scenario_name": sc.name,
-             "overrides": json.dumps(sc.overrides)}
+def root_attributes(sc: Scenario) -> dict:
+    return {"scenario_toml": sc.text, "seed": str(sc.seed) if sc.seed >= 2**63 else sc.seed,
+            "start_gps_week": sc.start_week, "start_gps_sow": sc.start_sow, "scenario_name": sc.name,
+            "overrides": json.dumps(list(sc.overrides))}
+
+
+def estimate_bytes(sc: Scenario, stages: Stages) -> int:
+    """An upper bound of the uncompressed output size (bytes)."""
+    n = stages.trajectory.n_samples()
+    total = n * 23 * 8                                           # /truth: t + 6 vectors + quaternion
+    if stages.imu is not None:
+        total += n * (13 + 3 * 16) * 8                           # t, rates, increments, up to 16 error terms
+    if stages.gnss is not None:
+        g = stages.gnss
+        m = g.epoch_times().size
+        s, a, k = len(g.sat_ids), g.n_ant, len(g.signals)
+        total += m * (4 * s + a * (8 + 10 * s) + k * a * s * 16) * 8
+    return int(total)
+
+
+def _scenario_file(scenario) -> Path | None:
+    try:
+        return resolve(scenario)
+    except ScenarioError:
+        return None
+
+
+def _sky(sc: Scenario, origin: np.ndarray) -> Sky:
+    """The constellation stage: load the sources, refuse duplicates and a sky with nothing to see."""
+    try:
+        sky = load_sky(sc.gnss.sources)
+    except DataFileError as exc:
+        index = next((i for i, s in enumerate(sc.gnss.sources) if str(s) in exc.path or exc.path in str(s)), 0)
+        raise ScenarioError(f"gnss.constellation[{index}].source", str(exc), sc.source) from None
+    if sky.duplicates:
+        raise ScenarioError("gnss.constellation", f"satellites loaded twice: {', '.join(sky.duplicates)}", sc.source)
+    _check_sky_covers_run(sc, sky, origin)
+    return sky
+
+
+def _check_sky_covers_run(sc: Scenario, sky: Sky, origin: np.ndarray) -> None:
+    """One clear error when no satellite has a state, or none rises above the mask, at the start position
+    ``origin`` (3,) m ECEF during the run (sampled every minute)."""
+    t = np.linspace(0.0, sc.duration_s, int(sc.duration_s // _SKY_CHECK_STEP_S) + 2)
+    week, sow = gpstime.add_seconds(sc.start_week, sc.start_sow, t)
+    with np.errstate(invalid="ignore"):
+        el = sky.view(np.broadcast_to(origin, (t.size, 3)), week, sow)["elevation"]
+    sources = ", ".join(sky.sources)
+    if not np.isfinite(el).any():
+        raise ScenarioError("gnss.constellation", f"{sources} gives no satellite state between "
+                            f"{sc.start.isoformat()} and +{sc.duration_s:g} s ({_coverage(sky)})", sc.source)
+    mask = sc.gnss.elevation_mask_rad
+    if not (el >= mask).any():
+        raise ScenarioError("gnss.elevation_mask_deg", f"no satellite of {sources} rises above "
+                            f"{np.degrees(mask):g} deg at the origin during the run", sc.source)
+
+
+def _coverage(sky: Sky) -> str:
+    spans = []
+    for c in sky.constellations:
+        span = getattr(c, "validity_span", None)
+        if callable(span):
+            first, last = span()
+            spans.append(f"{c.source} covers {first} to {last}")
+    return "; ".join(spans) or "check the source's dates"
+
+
+def _rows(prefix: str, obj) -> dict[str, np.ndarray]:
+    """Dataset path -> array for every field of a stage's dataclass."""
+    return {f"{prefix}/{f.name}": getattr(obj, f.name) for f in fields(obj)}
+
+
+def gnss_rows(ep, prefix: str = "gnss/") -> dict[str, np.ndarray]:
+    """Dataset path -> array of a block of :class:`simkit.gnss.GnssEpochs` (``prefix`` "" gives paths
+    relative to /gnss)."""
+    rows = {f"{prefix}t": ep.t, f"{prefix}sat_pos_ecef": ep.sat_pos_ecef, f"{prefix}sat_clock": ep.sat_clock}
+    rows.update(_rows(f"{prefix}truth", ep.truth))
+    for name, obs in ep.obs.items():
+        rows.update(_rows(f"{prefix}obs/{name}", obs))
+    for name, truth in ep.signal_truth.items():
+        rows.update(_rows(f"{prefix}truth/{name}", truth))
+    return rows
+
+
+def gnss_static_rows(st, prefix: str = "gnss/") -> dict[str, np.ndarray]:
+    """Dataset path -> array of :class:`simkit.gnss.GnssStatic`."""
+    return {(f"{prefix}antennas/{f.name}" if f.name in ("lever_arm_b", "boresight_b") else f"{prefix}{f.name}"):
+            getattr(st, f.name) for f in fields(st)}
+
+
+def _imu_rows(t, block) -> dict[str, np.ndarray]:
+    rows = {"imu/t": t, "imu/gyro": block.gyro, "imu/accel": block.accel}
+    if block.dtheta is not None:
+        rows["imu/dtheta"], rows["imu/dvel"] = block.dtheta, block.dvel
+    rows.update({f"imu/errors/{name}": data for name, data in block.errors.items()})
+    return rows
+
+
+def _write_static(w: Writer, sc: Scenario, stages: Stages) -> None:
+    w.group_attrs("truth", {"rate_hz": sc.trajectory.rate_hz})
+    if stages.imu is not None:
+        w.group_attrs("imu", dict(stages.imu.attributes(), rate_hz=sc.trajectory.rate_hz))
+    if stages.gnss is not None:
+        w.group_attrs("gnss", {"rate_hz": sc.gnss.rate_hz})
+        for path, data in gnss_static_rows(stages.gnss.static()).items():
+            w.write(path, data)
+
+
+def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress: bool) -> None:
+    _write_static(w, sc, stages)
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=n_total, unit="sample", unit_scale=True, desc=sc.name, leave=False)
-    with Writer(out, attrs) as w:
-        w.group_attrs("truth", {"rate_hz": rate})
-        if imu is not None:
-            w.group_attrs("imu", dict(imu.attributes(), rate_hz=rate))
-        if gnss is not None:
-            w.group_attrs("gnss", {"rate_hz": sc.gnss.rate_hz})
-            for name, (data, units) in gnss.static_datasets().items():
-                w.write(f"gnss/{name}", data, units)
-        k = 0
-        for truth in traj.blocks(block_samples=block_samples):
-            for name, data in truth.arrays().items():
-                w.append(f"truth/{name}", data, truth.UNITS[name])
-            if imu is not None:
-                block = imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)
-                gyro, accel, errors = block
-                w.append("imu/t", truth.t, "s")
-                w.append("imu/gyro", gyro, "rad/s")
-                w.append("imu/accel", accel, "m/s^2")
-                for name, data in block.increments.items():
-                    w.append(f"imu/{name}", data, "rad" if name == "dtheta" else "m/s")
-                for name, data in errors.items():
-                    w.append(f"imu/errors/{name}", data, "rad/s" if name.startswith("gyro") else "m/s^2")
-            if gnss is not None:
-                idx = np.nonzero((np.arange(k, k + len(truth)) % stride) == 0)[0]
-                if len(idx):
+        bar = tqdm(total=stages.trajectory.n_samples(), unit="sample", unit_scale=True, desc=sc.name, leave=False)
+    stride = int(round(sc.trajectory.rate_hz / sc.gnss.rate_hz)) if stages.gnss is not None else 0
+    k = 0
+    try:
+        for truth in stages.trajectory.blocks(block_samples=block_samples):
+            rows = _rows("truth", truth)
+            if stages.imu is not None:
+                rows.update(_imu_rows(truth.t, stages.imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)))
+            if stages.gnss is not None:
+                idx = np.nonzero((np.arange(k, k + len(truth.t)) % stride) == 0)[0]
+                if idx.size:
                     sub = truth.take(idx)
-                    for name, (data, units) in gnss.process(sub.t, sub.pos_ecef, sub.vel_ecef(), sub.quat_nb,
-                                                            sub.omega_ib_b).items():
-                        w.append(f"gnss/{name}", data, units)
-            k += len(truth)
+                    rows.update(gnss_rows(stages.gnss.process(sub.t, sub.pos_ecef, sub.vel_ecef(), sub.quat_nb,
+                                                               sub.omega_ib_b)))
+            for path, data in rows.items():
+                w.append(path, data)
+            k += len(truth.t)
             if bar is not None:
-                bar.update(len(truth))
-    if bar is not None:
-        bar.close()
-    return out
+                bar.update(len(truth.t))
+    finally:
+        if bar is not None:
+            bar.close()

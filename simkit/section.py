@@ -52,7 +52,11 @@ class Section:
         self._seen.add(name)
         if name not in self.data:
             if default is REQUIRED:
-                raise self.error(name, f"missing required key (expected {self._expect(kind, shape)})")
+                import difflib
+
+                near = difflib.get_close_matches(name, [str(k) for k in self.data], n=1)
+                hint = f"; found '{near[0]}': did you mean '{name}'?" if near else ""
+                raise self.error(name, f"missing required key (expected {self._expect(kind, shape)}{hint})")
             return default
         value = self.data[name]
         if shape is not None:

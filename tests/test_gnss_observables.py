@@ -6,8 +6,10 @@ import pytest
 
 from simkit import earth, frames
 from simkit.earth import C_LIGHT
+from simkit.constellation import load_sky
 from simkit.errors import ScenarioError
 from simkit.gnss import (GnssSimulator, dd_covariance, double_difference, parse_config, reference_satellites)
+from simkit.pipeline import gnss_rows, gnss_static_rows
 from simkit.section import Section
 
 from conftest import DATA
@@ -26,7 +28,7 @@ def make(extra=None, duration=120.0, seed=3, start=(WEEK, SOW)):
                          {"lever_arm_m": [0.0, 9.445, 0.2]}]}
     table.update(extra or {})
     cfg = parse_config(Section(table, "gnss"))
-    return GnssSimulator(cfg, start[0], start[1], seed, duration)
+    return GnssSimulator(cfg, load_sky(cfg.sources), start[0], start[1], seed, duration)
 
 
 def consistent_truth(pos, vel, heading_deg=30.0):
@@ -48,7 +50,8 @@ def run(sim, truth=None, blocks=1):
     t = sim.epoch_times()
     truth = truth or static_truth(t)
     parts = [sim.process(t[i], *(x[i] for x in truth)) for i in np.array_split(np.arange(t.size), blocks)]
-    return {k: np.concatenate([p[k][0] for p in parts]) for k in parts[0]}
+    rows = [gnss_rows(p, prefix="") for p in parts]
+    return {k: np.concatenate([r[k] for r in rows]) for k in rows[0]}
 
 
 def test_observables_equal_sum_of_truth_terms():

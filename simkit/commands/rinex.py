@@ -8,9 +8,24 @@ def add_parser(sub):
                                    "RINEX navigation files its scenario used, so RTKLIB and other tools can "
                                    "process the simulated data.")
     p.add_argument("file", help="simkit HDF5 file with a /gnss group")
-    p.add_argument("-o", "--out", default=".", help="output folder (default: the current folder)")
+    p.add_argument("-o", "--out", default=".", help="output folder, created if missing (default: the current folder)")
     p.add_argument("--name", default=None, help="file name stem (default: the scenario name)")
     return p
+
+
+def _out_dir(path):
+    import os
+    from pathlib import Path
+
+    from ..errors import OutputError
+
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise OutputError(out, "exists and is not a folder; -o takes the folder to write the RINEX files in")
+    parent = out if out.exists() else out.parent
+    if str(parent) and parent.exists() and not os.access(parent, os.W_OK):
+        raise OutputError(out, "folder is not writable")
+    return out
 
 
 def run(args) -> int:
@@ -20,17 +35,19 @@ def run(args) -> int:
     from ..errors import DataFileError
     from ..gnss.rinex import export
 
+    out = _out_dir(args.out)
     with open_dataset(args.file) as ds:
-        if "gnss" not in ds:
+        if "gnss/t" not in ds:
             raise DataFileError(args.file, "no /gnss group: the scenario has no [gnss] section")
         try:
             scenario = tomllib.loads(ds.attrs["scenario_toml"])
         except (KeyError, tomllib.TOMLDecodeError) as exc:
             raise DataFileError(args.file, f"unreadable scenario_toml attribute ({exc})") from exc
         sources = [c.get("source", "") for c in scenario.get("gnss", {}).get("constellation", [])]
-        name = args.name or scenario.get("scenario", {}).get("name", "simkit")
-        paths = export(ds["gnss"], int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]), args.out,
-                       sources, name)
+        name = args.name or ds.scenario_name
+        gnss = {path[len("gnss/"):]: arr for path, arr in ds.datasets() if path.startswith("gnss/")}
+        out.mkdir(parents=True, exist_ok=True)
+        paths = export(gnss, int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]), out, sources, name)
     for p in paths:
         print(p)
     skipped = [s for s in sources if s.startswith("nominal:")]

@@ -12,6 +12,8 @@ def add_parser(sub):
     p.add_argument("--seed", type=int, help="override scenario.seed")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override any scenario key, e.g. --set scenario.duration_s=60 (repeatable)")
+    p.add_argument("--force", action="store_true",
+                   help="run even when the estimated output exceeds the free disk space or the size limit")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
     return p
 
@@ -20,7 +22,8 @@ def run(args) -> int:
     from ..pipeline import run as simulate
 
     t0 = time.perf_counter()
-    out = simulate(args.scenario, out=args.out, seed=args.seed, overrides=args.overrides, progress=not args.quiet)
+    out = simulate(args.scenario, out=args.out, seed=args.seed, overrides=args.overrides, progress=not args.quiet,
+                   force=args.force)
     if not args.quiet:
         print(f"wrote {out} in {time.perf_counter() - t0:.1f} s")
     return 0

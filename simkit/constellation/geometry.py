@@ -39,6 +39,7 @@ class Geometry:
     los: np.ndarray
     elevation: np.ndarray
     azimuth: np.ndarray
+    sat_pos_emission: np.ndarray | None = None  # TEMPORARY
 
 
 def _rotate_z(vec, angle):
@@ -78,7 +79,7 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
     vel = _rotate_z(out[2], OMEGA_E * tau) if velocity else None
     ts = np.where(np.isfinite(rng), ts, np.nan)
     return Geometry(np.asarray(tw), ts, pos, vel, out[1], out[3] if velocity else None,
-                    rng, rng / C_LIGHT, los, el, az)
+                    rng, rng / C_LIGHT, los, el, az, out[0])
 
 
 def elevation_azimuth(rx_pos, los):

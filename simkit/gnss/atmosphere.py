@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import earth
 from ..earth import C_LIGHT
+from ..gpstime import BDT_MINUS_GPST
 
 DEFAULT_GPS_ALPHA = (2.2352e-08, 1.4901e-08, -1.1921e-07, -5.9605e-08)
 DEFAULT_GPS_BETA = (1.2493e05, 6.5536e04, -1.9661e05, 6.5536e04)
@@ -82,3 +84,36 @@ def troposphere(lat, h, el):
     """Slant tropospheric delay (m): Saastamoinen zenith delays mapped with 1/sin(el)."""
     zh, zw = saastamoinen_zenith(lat, h)
     return (zh + zw) / np.sin(el)
+
+
+def troposphere_rate(lat, h, el, h_rate, el_rate, dh: float = 1.0):
+    """Rate (m/s) of :func:`troposphere` for a receiver climbing at ``h_rate`` m/s and a satellite rising at
+    ``el_rate`` rad/s: dT/dh h' / sin(el) - T_z cos(el) / sin(el)^2 el' (dT/dh by a central difference over
+    +-``dh`` m: the zenith delay is smooth in height, the error is below 1e-9 m/m). The latitude term
+    (< 1e-5 m/s at 300 m/s) is left out."""
+    zh, zw = saastamoinen_zenith(lat, h)
+    up, down = saastamoinen_zenith(lat, h + dh), saastamoinen_zenith(lat, h - dh)
+    dz_dh = (up[0] + up[1] - down[0] - down[1]) / (2.0 * dh)
+    s = np.sin(el)
+    return dz_dh * h_rate / s - (zh + zw) * np.cos(el) / s**2 * el_rate
+
+
+def ionosphere(system: str, alpha, beta, lla, vel_enu, az, el, az_rate, el_rate, gps_tow, h: float = 0.05):
+    """Broadcast ionospheric delay (m, at the system's reference frequency: L1 for 'G', B1I for 'C') and its rate
+    (m/s) for receivers at ``lla`` (..., 3) moving at ``vel_enu`` (..., 3) m/s, satellites at ``az``/``el`` rad
+    moving at ``az_rate``/``el_rate`` rad/s, GPS time of week ``gps_tow`` s (BDS converts to BDT).
+
+    The rate is a central difference over +-``h`` s along both motions (receiver latitude/longitude rates
+    from the radii of curvature, satellite angles linearly): the model's curvature leaves < 1e-6 m/s.
+    """
+    model, shift = (klobuchar_gps, 0.0) if system == "G" else (klobuchar_bds, BDT_MINUS_GPST)
+    lat, lon, hgt = lla[..., 0], lla[..., 1], lla[..., 2]
+    rm, rn = earth.radii(lat)
+    lat_rate = vel_enu[..., 1] / (rm + hgt)
+    lon_rate = vel_enu[..., 0] / ((rn + hgt) * np.cos(lat))
+
+    def at(s):
+        return model(alpha, beta, (lat + s * lat_rate)[..., None], (lon + s * lon_rate)[..., None],
+                     az + s * az_rate, el + s * el_rate, gps_tow + shift + s)
+
+    return at(0.0), (at(h) - at(-h)) / (2.0 * h)

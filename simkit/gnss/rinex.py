@@ -7,6 +7,7 @@ indicator carries the /gnss/obs LLI bits, the signal-strength indicator is min(m
 """
 from __future__ import annotations
 
+import os
 import shutil
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
@@ -14,11 +15,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import gpstime
-from ..version import __version__
+from .. import frames
 from ..earth import C_LIGHT
+from ..version import __version__
 from . import signals as sigmod
 
-_GPS_EPOCH = datetime(1980, 1, 6)
+_GPS_EPOCH = gpstime.GPS_EPOCH.replace(tzinfo=None)
 
 
 def _hdr(text: str, label: str) -> str:
@@ -59,13 +61,26 @@ def _field(value: float, lli: int = 0, ssi: int = 0) -> str:
     return f"{value:14.3f}{li}{si}"
 
 
+def marker_type(antenna_pos_ecef) -> str:
+    """RINEX 3.04 MARKER TYPE of a track (M, 3) m ECEF: GEODETIC when it does not move (< 1 mm), AIRBORNE when
+    its height changes by more than 30 m, else GROUND_CRAFT."""
+    pos = np.asarray(antenna_pos_ecef, dtype=float)
+    pos = pos[np.isfinite(pos).all(axis=1)]
+    if pos.shape[0] < 2 or np.ptp(pos, axis=0).max() < 1e-3:
+        return "GEODETIC"
+    h = frames.ecef_to_lla(pos)[:, 2]
+    return "AIRBORNE" if np.ptp(h) > 30.0 else "GROUND_CRAFT"
+
+
 def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, approx_pos_ecef,
-              clock_bias_s=None, marker: str = "SIMKIT", interval_s: float | None = None) -> Path:
+              clock_bias_s=None, marker: str = "SIMKIT", interval_s: float | None = None,
+              kind: str = "GEODETIC") -> Path:
     """Write one antenna's observations as a RINEX 3.04 observation file.
 
     ``t`` (M,) s since (start_week, start_sow); ``obs``: signal name -> dict with "code", "carrier", "doppler",
     "cn0" (M, S) float and "lli" (M, S) uint8 for this antenna; ``clock_bias_s`` (M,) receiver clock bias added
-    to the time tags (None: true GPS time). Returns the path.
+    to the time tags (None: true GPS time); ``kind`` the MARKER TYPE. Written under a temporary name and
+    renamed when complete. Returns the path.
     """
     path = Path(path)
     t = np.asarray(t, dtype=float)
@@ -80,7 +95,7 @@ def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, ap
     head += _hdr(f"{'simkit ' + __version__:<20}{'simkit':<20}{now:<20}", "PGM / RUN BY / DATE")
     head += _hdr("simkit: time tags = true GPS time + receiver clock bias", "COMMENT")
     head += _hdr(marker, "MARKER NAME")
-    head += _hdr("GEODETIC", "MARKER TYPE")
+    head += _hdr(kind, "MARKER TYPE")
     head += _hdr(f"{'simkit':<20}{'simkit':<40}", "OBSERVER / AGENCY")
     head += _hdr(f"{'0':<20}{'SIMKIT':<20}{__version__:<20}", "REC # / TYPE / VERS")
     head += _hdr(f"{'0':<20}{'SIMKIT NONE':<20}", "ANT # / TYPE")
@@ -111,24 +126,33 @@ def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, ap
                 cols += [(o["code"], None, ssi), (o["carrier"], lli, ssi), (o["doppler"], None, None),
                          (o["cn0"], None, None)]
         columns[sys] = cols
-    sys_of = [s[0] for s in sat_ids]
-    with open(path, "w") as f:
-        f.write(head)
-        for k in range(t.size):
-            cal, frac = _calendar(*gpstime.add_seconds(start_week, start_sow, float(tag[k])))
-            lines = []
-            for j, sat in enumerate(sat_ids):
-                cols = columns.get(sys_of[j])
-                if not cols or not any(np.isfinite(c[0][k, j]) for c in cols):
-                    continue
-                fields = [_field(v[k, j], 0 if li is None else li[k, j], 0 if si is None else si[k, j])
-                          for v, li, si in cols]
-                lines.append(sat + "".join(fields).rstrip())
-            f.write(f"> {cal.year:4d} {cal.month:02d} {cal.day:02d} {cal.hour:02d} {cal.minute:02d}"
-                    f"{cal.second + frac:11.7f}  0{len(lines):3d}\n")
-            if lines:
-                f.write("\n".join(lines) + "\n")
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    try:
+        with open(tmp, "w") as f:
+            _write_epochs(f, head, start_week, start_sow, t, tag, sat_ids, columns)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
     return path
+
+
+def _write_epochs(f, head, start_week, start_sow, t, tag, sat_ids, columns) -> None:
+    sys_of = [s[0] for s in sat_ids]
+    f.write(head)
+    for k in range(t.size):
+        cal, frac = _calendar(*gpstime.add_seconds(start_week, start_sow, float(tag[k])))
+        lines = []
+        for j, sat in enumerate(sat_ids):
+            cols = columns.get(sys_of[j])
+            if not cols or not any(np.isfinite(c[0][k, j]) for c in cols):
+                continue
+            fields = [_field(v[k, j], 0 if li is None else li[k, j], 0 if si is None else si[k, j])
+                      for v, li, si in cols]
+            lines.append(sat + "".join(fields).rstrip())
+        f.write(f"> {cal.year:4d} {cal.month:02d} {cal.day:02d} {cal.hour:02d} {cal.minute:02d}"
+                f"{cal.second + frac:11.7f}  0{len(lines):3d}\n")
+        if lines:
+            f.write("\n".join(lines) + "\n")
 
 
 def copy_nav(sources, out_dir) -> list[Path]:
@@ -156,8 +180,7 @@ def copy_nav(sources, out_dir) -> list[Path]:
 def export(gnss, start_week: int, start_sow: float, out_dir, nav_sources=(), name: str = "simkit") -> list[Path]:
     """Write one RINEX 3.04 observation file per antenna, plus copies of the RINEX navigation sources.
 
-    ``gnss`` maps paths relative to /gnss to arrays (an open h5py group or the dict of
-    :meth:`GnssSimulator.process` outputs, values as arrays): needs ``t``, ``sat_id``, ``obs/<signal>/...``,
+    ``gnss`` maps paths relative to /gnss to arrays (numpy or lazy :class:`simkit.io.Array`): needs ``t``, ``sat_id``, ``obs/<signal>/...``,
     ``truth/receiver_clock`` (m, for the time tags) and ``truth/antenna_pos_ecef`` (approximate position).
     ``nav_sources``: constellation sources; those that are files are copied (``nominal:`` ones have no file).
     Returns the written paths (observation files first).
@@ -165,18 +188,19 @@ def export(gnss, start_week: int, start_sow: float, out_dir, nav_sources=(), nam
     from ..constellation.sources import resolve
 
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     t = np.asarray(gnss["t"][...], dtype=float)
     sat_ids = [s.decode() if isinstance(s, bytes) else str(s) for s in np.asarray(gnss["sat_id"][...])]
     sig_names = [n for n in sigmod.SIGNALS if f"obs/{n}/code" in gnss]
     clock = np.asarray(gnss["truth/receiver_clock"][...], dtype=float) / C_LIGHT
-    ant_pos = np.asarray(gnss["truth/antenna_pos_ecef"][0], dtype=float)
+    track = np.asarray(gnss["truth/antenna_pos_ecef"][...], dtype=float)
+    ant_pos = track[0]
     interval = float(np.median(np.diff(t))) if t.size > 1 else None
     paths = []
     for a in range(ant_pos.shape[0]):
         obs = {n: {f: np.asarray(gnss[f"obs/{n}/{f}"][:, a, :]) for f in ("code", "carrier", "doppler", "cn0", "lli")}
                for n in sig_names}
         paths.append(write_obs(out_dir / f"{name}_ant{a}.rnx", start_week, start_sow, t, sat_ids, obs,
-                               ant_pos[a], clock[:, a], marker=f"{name.upper()}{a}", interval_s=interval))
+                               ant_pos[a], clock[:, a], marker=f"{name.upper()}_ANT{a}", interval_s=interval,
+                               kind=marker_type(track[:, a])))
     files = [resolve(s) for s in nav_sources if not str(s).startswith("nominal:")]
     return paths + copy_nav(files, out_dir)

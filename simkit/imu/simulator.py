@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import math
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..rng import generator
@@ -21,13 +23,15 @@ from .noise import Flicker, GaussMarkov, LowPass, Quantizer, RandomWalk, WhiteNo
 from .vibration import Vibration
 
 
-class ImuBlock(tuple):
-    """``(gyro, accel, errors)`` of one block; ``.increments`` holds {"dtheta", "dvel"} in increments mode."""
+@dataclass(frozen=True)
+class ImuBlock:
+    """TEMPORARY (replaced by the IMU refactor)."""
 
-    def __new__(cls, gyro, accel, errors, increments):
-        block = super().__new__(cls, (gyro, accel, errors))
-        block.increments = increments
-        return block
+    gyro: np.ndarray
+    accel: np.ndarray
+    dtheta: np.ndarray | None
+    dvel: np.ndarray | None
+    errors: dict
 
 
 def truth_increments(x: np.ndarray, prev: np.ndarray | None, dt: float) -> np.ndarray:
@@ -175,7 +179,7 @@ class ImuSimulator:
         gyro, gerr, dtheta = self.gyro.process(omega, f)
         accel, aerr, dvel = self.accel.process(f, f)
         inc = {"dtheta": dtheta, "dvel": dvel} if dtheta is not None else {}
-        return ImuBlock(gyro, accel, {**gerr, **aerr}, inc)
+        return ImuBlock(gyro, accel, inc.get("dtheta"), inc.get("dvel"), {**gerr, **aerr})
 
     def attributes(self) -> dict:
         """Model parameters (resolved preset + overrides, SI units) and the run's random constants, JSON-ready."""

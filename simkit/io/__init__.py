@@ -1,5 +1,9 @@
-"""HDF5 input/output (the only stage that knows HDF5): schema v1 writer and lazy reader."""
-from .reader import Dataset, open_dataset
+"""HDF5 input/output, the only stage that knows HDF5: the schema (:mod:`.schema`), the block writer, the lazy
+reader, and the checks on an output path."""
+from .output import check_output
+from .reader import Array, Dataset, open_dataset
+from .schema import SCHEMA, SCHEMA_VERSION, Field, SchemaError, field
 from .writer import Writer
 
-__all__ = ["Dataset", "Writer", "open_dataset"]
+__all__ = ["Array", "Dataset", "Field", "SCHEMA", "SCHEMA_VERSION", "SchemaError", "Writer", "check_output",
+           "field", "open_dataset"]

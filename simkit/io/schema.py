@@ -58,7 +58,7 @@ _TRUTH = [
     _f("truth/pos_lla", "f8", ("N", 3), "rad, rad, m", "WGS-84", "trajectory",
        "latitude, longitude, ellipsoidal height"),
     _f("truth/vel_enu", "f8", ("N", 3), "m/s", "ENU", "trajectory", "velocity relative to the Earth"),
-    _f("truth/quat_nb", "f8", ("N", 4), "", "body->ENU", "trajectory", "attitude quaternion, scalar last"),
+    _f("truth/quat_nb", "f8", ("N", 4), "1 (x, y, z, w)", "body->ENU", "trajectory", "attitude quaternion, scalar last"),
     _f("truth/euler", "f8", ("N", 3), "rad", "body->ENU", "trajectory", "pitch, roll, heading"),
     _f("truth/omega_ib_b", "f8", ("N", 3), "rad/s", "body", "trajectory",
        "body rate w.r.t. inertial space (Earth rate included)"),
@@ -85,7 +85,7 @@ _GNSS = [
     _f("gnss/sat_clock", "f8", ("M", "S"), "s", "", "gnss",
        "satellite clock at emission: af0 + af1 dt + af2 dt^2 + relativity"),
     _f("gnss/antennas/lever_arm_b", "f8", ("A", 3), "m", "body", "gnss", "phase centre from the IMU centre"),
-    _f("gnss/antennas/boresight_b", "f8", ("A", 3), "", "body", "gnss", "antenna boresight direction"),
+    _f("gnss/antennas/boresight_b", "f8", ("A", 3), "1", "body", "gnss", "antenna boresight direction"),
     _f("gnss/obs/<signal>/code", "f8", ("M", "A", "S"), "m", "", "gnss", "pseudorange; NaN where not tracked"),
     _f("gnss/obs/<signal>/carrier", "f8", ("M", "A", "S"), "cycles", "", "gnss", "carrier phase"),
     _f("gnss/obs/<signal>/doppler", "f8", ("M", "A", "S"), "Hz", "", "gnss",
@@ -123,7 +123,7 @@ _SOLUTIONS = [
     _f("solutions/<name>/t", "f8", ("K",), "s", "", "estimators", "solution epochs since start"),
     _f("solutions/<name>/pos_ecef", "f8", ("K", 3), "m", "ECEF", "estimators", "estimated IMU-centre position"),
     _f("solutions/<name>/vel_enu", "f8", ("K", 3), "m/s", "ENU", "estimators", "estimated velocity"),
-    _f("solutions/<name>/quat_nb", "f8", ("K", 4), "", "body->ENU", "estimators", "estimated attitude"),
+    _f("solutions/<name>/quat_nb", "f8", ("K", 4), "1 (x, y, z, w)", "body->ENU", "estimators", "estimated attitude"),
     _f("solutions/<name>/euler", "f8", ("K", 3), "rad", "body->ENU", "estimators", "pitch, roll, heading"),
     _f("solutions/<name>/cov", "f8", ("K", "X", "X"), "SI", "", "estimators",
        "state covariance, in the order of state_names"),
@@ -136,7 +136,7 @@ SCHEMA: tuple[Field, ...] = tuple(_TRUTH + _IMU + _GNSS + _SOLUTIONS)
 
 GROUP_ATTRS = {
     "truth": {"rate_hz": "trajectory.rate_hz"},
-    "imu": {"rate_hz": "IMU rate", "model": "the IMU error model parameters, JSON"},
+    "imu": {"rate_hz": "IMU rate", "<parameter>": "the IMU error model parameters (JSON text where not scalar)"},
     "gnss": {"rate_hz": "gnss.rate_hz"},
     "solutions/<name>": {"config": "the estimator configuration, JSON"},
 }

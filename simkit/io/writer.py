@@ -2,8 +2,9 @@
 
 Time series are compressed chunk by chunk in a thread pool (byte shuffle + deflate level 1 in zlib format, which
 is what HDF5's shuffle and deflate filters read, so any HDF5 reader decodes them) and stored with direct chunk
-writes. Deflate is ISA-L's (``isal``): the same format at about 13x zlib's speed; it releases the GIL, so
-compression runs beside the simulation. The file is written under a temporary name
+writes. Deflate is ISA-L's (``isal``, the optional ``fast`` extra) when installed: the same format at about 13x
+zlib's speed; otherwise the standard library's ``zlib``. Both release the GIL, so compression runs beside the
+simulation. The file is written under a temporary name
 in the destination folder and renamed only when complete, so an interrupted run never leaves a truncated file
 under the output name.
 """
@@ -17,10 +18,15 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-from isal import isal_zlib
 
 from ..version import __version__
+from . import schema
 from .schema import SCHEMA_VERSION
+
+try:  # ISA-L writes the same zlib format as the standard library, ~13x faster
+    from isal import isal_zlib as deflate
+except ImportError:  # pragma: no cover - exercised by the test that hides isal
+    import zlib as deflate
 
 CHUNK_ROWS = 1 << 16  # time samples per chunk along the first axis
 
@@ -33,7 +39,33 @@ def _chunks(shape, itemsize):
 def _shuffle_deflate(chunk: np.ndarray) -> bytes:
     """The bytes HDF5's shuffle + deflate(level 1) filters make of one full chunk."""
     raw = np.ascontiguousarray(chunk).view(np.uint8).reshape(-1, chunk.dtype.itemsize)
-    return isal_zlib.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
+    return deflate.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's live process
+        return True
+    return True
+
+
+def temporary_name(path: Path, pid: int | None = None) -> Path:
+    """Where ``path`` is written until it is complete: a hidden name with the writer's process id."""
+    return path.with_name(f".{path.name}.tmp-{os.getpid() if pid is None else pid}")
+
+
+def remove_stale_temporaries(path: Path) -> list[Path]:
+    """Remove the temporary files of ``path`` left by writers that died (SIGKILL, power loss); returns them."""
+    removed = []
+    for tmp in path.parent.glob(f".{path.name}.tmp-*"):
+        pid = tmp.name.rsplit("-", 1)[-1]
+        if pid.isdigit() and int(pid) != os.getpid() and not _pid_alive(int(pid)):
+            tmp.unlink(missing_ok=True)
+            removed.append(tmp)
+    return removed
 
 
 class _Series:
@@ -53,7 +85,7 @@ class Writer:
 
     def __init__(self, path: str | Path, attrs: dict):
         self.path = Path(path)
-        self.tmp = self.path.with_name(f".{self.path.name}.tmp-{os.getpid()}")
+        self.tmp = temporary_name(self.path)
         self.attrs = attrs
         self.file: h5py.File | None = None
         self._series: dict[str, _Series] = {}
@@ -61,7 +93,7 @@ class Writer:
         self._pool = ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1)))
 
     def __enter__(self) -> "Writer":
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        remove_stale_temporaries(self.path)
         self.file = h5py.File(self.tmp, "w")
         f = self.file
         f.attrs["schema_version"] = SCHEMA_VERSION
@@ -91,16 +123,16 @@ class Writer:
         return dict(chunks=_chunks(shape, np.dtype(dtype).itemsize), compression="gzip", compression_opts=1,
                     shuffle=True)
 
-    def append(self, name: str, block: np.ndarray, units: str, attrs: dict | None = None) -> None:
-        """Append ``block`` along axis 0 of dataset ``name`` (created on first use, resizable)."""
+    def append(self, name: str, block: np.ndarray, attrs: dict | None = None) -> None:
+        """Append ``block`` along axis 0 of dataset ``name`` (declared in :mod:`.schema`; created on first use,
+        resizable)."""
         block = np.asarray(block)
         if name not in self._series:
+            spec = schema.check(name, block.dtype, block.shape)
             shape = (0,) + block.shape[1:]
             ds = self.file.create_dataset(name, shape=shape, maxshape=(None,) + block.shape[1:], dtype=block.dtype,
                                           **self._options((CHUNK_ROWS,) + block.shape[1:], block.dtype))
-            ds.attrs["units"] = units
-            for k, v in (attrs or {}).items():
-                ds.attrs[k] = v
+            self._describe(ds, spec, attrs)
             self._series[name] = _Series(ds)
         series = self._series[name]
         if block.shape[1:] != series.ds.shape[1:] or block.dtype != series.ds.dtype:
@@ -137,13 +169,19 @@ class Writer:
             ds, offset, job = self._jobs.pop(0)
             ds.id.write_direct_chunk(offset, job.result())
 
-    def write(self, name: str, data, units: str, attrs: dict | None = None) -> None:
-        """Write a whole (small, time-independent) dataset."""
+    def write(self, name: str, data, attrs: dict | None = None) -> None:
+        """Write a whole (small, time-independent) dataset declared in :mod:`.schema`."""
         data = np.asarray(data)
-        if data.dtype.kind == "U":
+        spec = schema.check(name, data.dtype, data.shape)
+        if data.dtype.kind in "UO":
             data = data.astype(h5py.string_dtype())
-        ds = self.file.create_dataset(name, data=data)
-        ds.attrs["units"] = units
+        self._describe(self.file.create_dataset(name, data=data), spec, attrs)
+
+    @staticmethod
+    def _describe(ds, spec: schema.Field, attrs: dict | None) -> None:
+        ds.attrs["units"] = spec.units
+        if spec.frame:
+            ds.attrs["frame"] = spec.frame
         for k, v in (attrs or {}).items():
             ds.attrs[k] = v
 

@@ -8,18 +8,20 @@ from __future__ import annotations
 import copy
 import re
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import datetime
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import tomli_w
+
 from .. import gpstime
 from ..errors import ScenarioError
-from ..gnss import parse_config as parse_gnss
-from ..imu import parse_config as parse_imu
+from ..gnss import GnssConfig, parse_config as parse_gnss
+from ..imu import ImuConfig, parse_config as parse_imu
 from ..section import Section, positive
-from ..trajectory import parse_config as parse_trajectory
+from ..trajectory import TrajectoryConfig, parse_config as parse_trajectory
 
 _INDEX = re.compile(r"^([A-Za-z_][\w-]*)(?:\[(\d+)\])?$")
 
@@ -38,15 +40,18 @@ def resolve(path_or_name: str | Path) -> Path:
     p = Path(path_or_name)
     if p.is_file():
         return p
+    if p.is_dir():
+        raise ScenarioError("", "is a directory, expected a scenario TOML file", str(p))
     candidate = bundled_dir() / (p.name if p.suffix == ".toml" else p.name + ".toml")
     if candidate.is_file() and (len(p.parts) == 1 or p.parent.name == "scenarios"):
         return candidate
     raise ScenarioError("", f"no such scenario file (bundled scenarios: {', '.join(bundled_names())})", str(p))
 
 
-@dataclass
+@dataclass(frozen=True)
 class Scenario:
-    """A validated scenario. Times: ``start_week``/``start_sow`` in GPS time; ``duration_s`` in seconds."""
+    """A validated scenario. Times: ``start_week``/``start_sow`` in GPS time; ``duration_s`` in seconds.
+    ``text`` is the effective scenario TOML, ``source`` where it came from, ``data`` the parsed table."""
 
     name: str
     description: str
@@ -55,13 +60,13 @@ class Scenario:
     start_sow: float
     duration_s: float
     seed: int
-    text: str
-    source: str
-    data: dict
-    trajectory: Any
-    imu: Any = None
-    gnss: Any = None
-    overrides: list = field(default_factory=list)
+    trajectory: TrajectoryConfig
+    imu: ImuConfig | None = None
+    gnss: GnssConfig | None = None
+    text: str = ""
+    source: str = ""
+    data: dict = field(default_factory=dict)
+    overrides: tuple = ()
 
 
 def parse_value(text: str):
@@ -101,9 +106,21 @@ def apply_override(data: dict, assignment: str) -> None:
                 raise ScenarioError(key, f"--set: {name} is not a table")
 
 
-def load(scenario: str | Path | dict, overrides: list[str] | None = None) -> Scenario:
-    """Read, override and validate a scenario (a TOML path, a bundled name, or a dict)."""
+MAX_SEED = 2**64 - 1
+
+
+def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: int | None = None) -> Scenario:
+    """Read, override and validate a scenario (a TOML path, a bundled name, or a dict).
+
+    ``seed`` (``--seed``) is the override ``scenario.seed``. ``Scenario.text`` is the effective scenario: the
+    file's own text when nothing was overridden, else the overridden table written with ``tomli_w`` (running
+    that text reproduces the run exactly).
+    """
     overrides = list(overrides or [])
+    if seed is not None:
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+            raise ScenarioError("--seed", f"expected an integer in [0, 2^64 - 1], got {seed!r}")
+        overrides.append(f"scenario.seed={seed}")
     if isinstance(scenario, dict):
         data, text, source = copy.deepcopy(scenario), None, "<dict>"
     else:
@@ -122,12 +139,10 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None) -> Sce
         sc = _validate(data)
     except ScenarioError as exc:
         raise exc.with_source(source) from None
-    sc.source = source
-    sc.text = text if text is not None else _to_toml(data)
-    if overrides and text is not None:
-        sc.text += "\n# overrides applied on top of the text above:\n" + "".join(f"# --set {o}\n" for o in overrides)
-    sc.overrides = overrides
-    return sc
+    if text is None or overrides:
+        header = f"# effective scenario: {source}" + "".join(f"\n# --set {o}" for o in overrides)
+        text = header + "\n" + tomli_w.dumps(data)
+    return replace(sc, text=text, source=source, data=data, overrides=tuple(overrides))
 
 
 def _validate(data: dict) -> Scenario:
@@ -142,7 +157,7 @@ def _validate(data: dict) -> Scenario:
     except ValueError:
         raise meta.error("start", f"expected a UTC ISO 8601 time like 2016-11-08T00:00:00Z, got {start_text!r}")
     duration = meta.get("duration_s", float, check=positive)
-    seed = meta.get("seed", int, 0, check=lambda v: None if v >= 0 else "must be >= 0")
+    seed = meta.get("seed", int, 0, check=lambda v: None if 0 <= v <= MAX_SEED else "must be in [0, 2^64 - 1]")
     meta.done()
     week, sow = gpstime.utc_to_gps(start)
 
@@ -162,41 +177,4 @@ def _validate(data: dict) -> Scenario:
                                 f"number of samples, got {gnss.rate_hz:g}")
     root.done()
     return Scenario(name=name, description=description, start=start, start_week=week, start_sow=sow,
-                    duration_s=duration, seed=seed, text="", source="", data=data, trajectory=traj, imu=imu,
-                    gnss=gnss)
-
-
-def _to_toml(data: dict) -> str:
-    """A TOML rendering of a scenario dict (for provenance of scenarios given as dicts)."""
-    lines: list[str] = []
-
-    def scalar(v):
-        if isinstance(v, bool):
-            return "true" if v else "false"
-        if isinstance(v, str):
-            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-        if isinstance(v, dict):
-            return "{" + ", ".join(f"{k} = {scalar(x)}" for k, x in v.items()) + "}"
-        if isinstance(v, list):
-            return "[" + ", ".join(scalar(x) for x in v) + "]"
-        return repr(v)
-
-    def table(prefix, d):
-        simple = {k: v for k, v in d.items() if not isinstance(v, dict) and not (
-            isinstance(v, list) and v and all(isinstance(i, dict) for i in v))}
-        for k, v in simple.items():
-            lines.append(f"{k} = {scalar(v)}")
-        for k, v in d.items():
-            if k in simple:
-                continue
-            name = f"{prefix}.{k}" if prefix else k
-            if isinstance(v, dict):
-                lines.append(f"\n[{name}]")
-                table(name, v)
-            else:
-                for item in v:
-                    lines.append(f"\n[[{name}]]")
-                    table(name, item)
-
-    table("", data)
-    return "\n".join(lines).lstrip() + "\n"
+                    duration_s=duration, seed=seed, trajectory=traj, imu=imu, gnss=gnss)
