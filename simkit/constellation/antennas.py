@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import frames
+from .. import earth, frames
 from ..earth import C_LIGHT, OMEGA_E
 from .geometry import elevation_azimuth
 
@@ -80,10 +80,12 @@ def _angle_rates(u, rng, rel_vel, ant_pos, ant_vel):
     u_dot = (rel_vel - u * np.einsum("masi,masi->mas", u, rel_vel)[..., None]) / rng[..., None]
     lla = frames.ecef_to_lla(ant_pos.reshape(-1, 3)).reshape(ant_pos.shape)
     c_en = frames.ecef_to_enu_matrix(lla[..., 0], lla[..., 1])    # (M, A, 3, 3)
+    vel_enu = np.einsum("maij,maj->mai", c_en, ant_vel)
+    # the antenna's ENU axes turn relative to ECEF at the transport rate: d(C_e^n u)/dt = C_e^n u' - w_en x (C_e^n u)
+    w_en = earth.transport_rate_enu(lla[..., 0], lla[..., 2], vel_enu)
     enu = np.einsum("maij,masj->masi", c_en, u)
-    enu_dot = np.einsum("maij,masj->masi", c_en, u_dot)
+    enu_dot = np.einsum("maij,masj->masi", c_en, u_dot) - np.cross(w_en[:, :, None, :], enu)
     el_rate = enu_dot[..., 2] / np.sqrt(np.maximum(1.0 - enu[..., 2] ** 2, 1e-12))
     hz = enu[..., 0] ** 2 + enu[..., 1] ** 2
     az_rate = (enu[..., 1] * enu_dot[..., 0] - enu[..., 0] * enu_dot[..., 1]) / np.maximum(hz, 1e-12)
-    vel_enu = np.einsum("maij,maj->mai", c_en, ant_vel)
     return el_rate, az_rate, lla, vel_enu
