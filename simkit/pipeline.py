@@ -24,6 +24,7 @@ from .trajectory import Trajectory
 BLOCK_SAMPLES = 1 << 16
 MAX_OUTPUT_BYTES = 100 * 2**30  # refuse larger runs unless forced: a typo in duration_s, not a dataset
 _SKY_CHECK_STEP_S = 60.0
+_SKY_CHECK_MAX = 1440
 
 
 @dataclass(frozen=True)
@@ -44,27 +45,29 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
     :data:`MAX_OUTPUT_BYTES` unless ``force``).
     """
     sc = load(scenario, overrides, seed=seed)
-    stages = build(sc)
     out = Path(out) if out is not None else Path(f"{sc.name}.h5")
-    size = estimate_bytes(sc, stages)
+    sky = _sky(sc) if sc.gnss is not None else None
+    size = estimate_bytes(sc, len(sky.sat_ids) if sky is not None else 0)
     if size > MAX_OUTPUT_BYTES and not force:
         raise OutputError(out, f"the run would write about {size / 2**30:.0f} GiB (limit {MAX_OUTPUT_BYTES / 2**30:.0f}"
                           f" GiB; scenario.duration_s = {sc.duration_s:g}); --force to run it anyway")
     source = None if isinstance(scenario, dict) else _scenario_file(scenario)
     check_output(out, inputs=[source], estimated_bytes=size, force=force)
+    stages = build(sc, sky)
     with Writer(out, root_attributes(sc)) as w:
         _write(w, sc, stages, block_samples, progress)
     return out
 
 
-def build(sc: Scenario) -> Stages:
-    """The stages of scenario ``sc`` (the sky is loaded and checked to cover the run)."""
+def build(sc: Scenario, sky: Sky | None = None) -> Stages:
+    """The stages of scenario ``sc``; ``sky`` (loaded from ``sc.gnss`` when not given) is first checked to
+    cover the run."""
     traj = Trajectory(sc.trajectory, sc.duration_s)
     imu = ImuSimulator(sc.imu, sc.trajectory.rate_hz, sc.seed) if sc.imu is not None else None
     gnss = None
     if sc.gnss is not None:
-        origin = next(traj.blocks(block_samples=1)).pos_ecef[0]
-        sky = _sky(sc, origin)
+        sky = sky if sky is not None else _sky(sc)
+        _check_sky_covers_run(sc, sky, next(traj.blocks(block_samples=1)).pos_ecef[0])
         gnss = GnssSimulator(sc.gnss, sky, sc.start_week, sc.start_sow, sc.seed, sc.duration_s)
     return Stages(traj, imu, gnss)
 
@@ -75,18 +78,17 @@ def root_attributes(sc: Scenario) -> dict:
             "overrides": json.dumps(list(sc.overrides))}
 
 
-def estimate_bytes(sc: Scenario, stages: Stages) -> int:
-    """An upper bound of the uncompressed output size (bytes)."""
-    n = stages.trajectory.n_samples()
+def estimate_bytes(sc: Scenario, n_sats: int) -> float:
+    """An upper bound of the uncompressed output size (bytes), from the configuration alone."""
+    n = sc.duration_s * sc.trajectory.rate_hz + 1
     total = n * 23 * 8                                           # /truth: t + 6 vectors + quaternion
-    if stages.imu is not None:
+    if sc.imu is not None:
         total += n * (13 + 3 * 16) * 8                           # t, rates, increments, up to 16 error terms
-    if stages.gnss is not None:
-        g = stages.gnss
-        m = g.epoch_times().size
-        s, a, k = len(g.sat_ids), g.n_ant, len(g.signals)
-        total += m * (4 * s + a * (8 + 10 * s) + k * a * s * 16) * 8
-    return int(total)
+    if sc.gnss is not None:
+        m = sc.duration_s * sc.gnss.rate_hz + 1
+        a, k = len(sc.gnss.antennas), len(sc.gnss.signals)
+        total += m * (4 * n_sats + a * (8 + 10 * n_sats) + k * a * n_sats * 16) * 8
+    return float(total)
 
 
 def _scenario_file(scenario) -> Path | None:
@@ -96,7 +98,7 @@ def _scenario_file(scenario) -> Path | None:
         return None
 
 
-def _sky(sc: Scenario, origin: np.ndarray) -> Sky:
+def _sky(sc: Scenario) -> Sky:
     """The constellation stage: load the sources, refuse duplicates and a sky with nothing to see."""
     try:
         sky = load_sky(sc.gnss.sources)
@@ -105,14 +107,13 @@ def _sky(sc: Scenario, origin: np.ndarray) -> Sky:
         raise ScenarioError(f"gnss.constellation[{index}].source", str(exc), sc.source) from None
     if sky.duplicates:
         raise ScenarioError("gnss.constellation", f"satellites loaded twice: {', '.join(sky.duplicates)}", sc.source)
-    _check_sky_covers_run(sc, sky, origin)
     return sky
 
 
 def _check_sky_covers_run(sc: Scenario, sky: Sky, origin: np.ndarray) -> None:
     """One clear error when no satellite has a state, or none rises above the mask, at the start position
     ``origin`` (3,) m ECEF during the run (sampled every minute)."""
-    t = np.linspace(0.0, sc.duration_s, int(sc.duration_s // _SKY_CHECK_STEP_S) + 2)
+    t = np.linspace(0.0, sc.duration_s, int(min(sc.duration_s // _SKY_CHECK_STEP_S, _SKY_CHECK_MAX)) + 2)
     week, sow = gpstime.add_seconds(sc.start_week, sc.start_sow, t)
     with np.errstate(invalid="ignore"):
         el = sky.view(np.broadcast_to(origin, (t.size, 3)), week, sow)["elevation"]

@@ -1,0 +1,147 @@
+"""Bad input to ``simkit run``, ``inspect`` and ``rinex``: one line on stderr naming the file / key and what was
+expected, exit code 2, no traceback, nothing left on disk."""
+import os
+from pathlib import Path
+
+import h5py
+import pytest
+
+from cli_errors import assert_clean_error
+
+GOOD = """[scenario]
+name = "tiny"
+start = "2026-04-27T06:00:00Z"
+duration_s = 2.0
+
+[trajectory]
+rate_hz = 10.0
+origin = { lat_deg = 34.2, lon_deg = 108.9, height_m = 400.0 }
+
+[[trajectory.segment]]
+kind = "static"
+duration_s = 2.0
+"""
+GNSS = """
+[gnss]
+rate_hz = 1.0
+elevation_mask_deg = {mask}
+signals = ["L1C"]
+
+[[gnss.constellation]]
+source = "{source}"
+
+[[gnss.antenna]]
+lever_arm_m = [0.0, 0.0, 0.0]
+"""
+
+
+def _scenario(folder: Path, text: str, name: str = "s.toml") -> str:
+    (folder / name).write_text(text)
+    return name
+
+
+RUN_CASES = [
+    # (scenario text or None for the bundled quickstart, extra args, expected text in the error line)
+    (None, ["--seed", "-1"], "--seed: expected an integer in [0, 2^64 - 1]"),
+    (None, ["--seed", str(2**64)], "--seed: expected an integer in [0, 2^64 - 1]"),
+    (None, ["--seed", "abc"], "invalid int value"),
+    (None, ["--set", "scenario.duration_s=1e9"], "--force to run it anyway"),
+    (None, ["--set", "scenario.duration_s=-5"], "scenario.duration_s: must be > 0"),
+    (None, ["--set", "scenario.duration_s=nan"], "scenario.duration_s: expected a finite number"),
+    (None, ["--set", "scenario.seed=-3"], "scenario.seed: must be in [0, 2^64 - 1]"),
+    (None, ["--set", "scenario.start='yesterday'"], "scenario.start: expected a UTC ISO 8601 time"),
+    (None, ["--set", "trajectory.colour=1"], "trajectory.colour: unknown key"),
+    (None, ["--set", "trajectory.segment[9].kind='turn'"], "no index 9"),
+    (None, ["--set", "trajectory.segment[1].accel_m_per_s2='fast'"], "expected a number"),
+    (None, ["--set", "trajectory.origin.lat_deg=100.0"], "trajectory.origin.lat_deg: must be in [-90, 90]"),
+    (None, ["--set", "gnss.elevation_mask_deg=89.9"], "gnss.elevation_mask_deg: no satellite"),
+    (None, ["--set", "gnss.rate_hz=3.0"], "gnss.rate_hz: must divide trajectory.rate_hz"),
+    (None, ["--set", "gnss.signals=['L9X']"], "gnss.signals"),
+    (None, ["--set", "gnss.constellation[0].source='missing.rnx'"], "gnss.constellation[0].source"),
+    (None, ["--set", "scenario.start='2001-01-01T00:00:00Z'"], "gives no satellite state"),
+    (None, ["--set", "imu.preset='no_such_imu'"], "imu.preset"),
+    (None, ["--set", "imu.rate_hz=7.0"], "imu.rate_hz: must equal trajectory.rate_hz"),
+    (None, ["--set", "novalue"], "--set: expected dotted.key=value"),
+    (GOOD.replace("duration_s = 2.0\n\n[trajectory]", "duraton_s = 2.0\n\n[trajectory]"), [],
+     "scenario.duration_s: missing required key (expected a number; found 'duraton_s'"),
+    (GOOD.replace('name = "tiny"', 'name = "a b"'), [], "scenario.name: must be letters"),
+    ("[scenario\nname = 1\n", [], "not valid TOML"),
+    (GOOD + GNSS.format(mask=10.0, source="nominal:gps") + GNSS.format(mask=10.0, source="nominal:gps")
+     .replace("[gnss]\nrate_hz = 1.0\nelevation_mask_deg = 10.0\nsignals = [\"L1C\"]\n", ""), [],
+     "satellites loaded twice"),
+]
+
+
+@pytest.mark.parametrize("text,extra,expect", RUN_CASES, ids=[str(i) for i in range(len(RUN_CASES))])
+def test_run_bad_scenarios(tmp_path, text, extra, expect):
+    scenario = "quickstart" if text is None else _scenario(tmp_path, text)
+    assert_clean_error(["run", scenario, "-q", "-o", "out.h5", *extra], tmp_path, expect)
+
+
+def test_run_directory_as_scenario(tmp_path):
+    (tmp_path / "folder").mkdir()
+    assert_clean_error(["run", "folder", "-q"], tmp_path, "is a directory, expected a scenario TOML file")
+
+
+def test_run_missing_scenario(tmp_path):
+    assert_clean_error(["run", "nowhere.toml", "-q"], tmp_path, "no such scenario file")
+
+
+@pytest.mark.parametrize("out,expect", [
+    ("missing_dir/out.h5", "folder missing_dir does not exist"),
+    (".", "is a directory"),
+    ("s.toml", "is an input of this run"),
+])
+def test_run_bad_output_paths(tmp_path, out, expect):
+    _scenario(tmp_path, GOOD)
+    assert_clean_error(["run", "s.toml", "-q", "-o", out], tmp_path, expect)
+
+
+def test_run_output_below_a_file(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    assert_clean_error(["run", "quickstart", "-q", "-o", "afile/x.h5"], tmp_path, "does not exist")
+
+
+def test_run_unwritable_folder(tmp_path, monkeypatch):
+    """A folder where the temporary file cannot be created (read-only, or root-owned for a user; CI runs as
+    root, so the failure is injected at the probe) is refused before any simulation."""
+    from simkit.io import output
+
+    real_open = os.open
+
+    def deny(path, *a, **k):
+        if ".out.h5.tmp-" in str(path):
+            raise PermissionError(13, "Permission denied")
+        return real_open(path, *a, **k)
+
+    monkeypatch.setattr(output.os, "open", deny)
+    import simkit
+    from simkit.errors import OutputError
+
+    with pytest.raises(OutputError, match="cannot write in"):
+        simkit.run("quickstart", out=tmp_path / "out.h5")
+    assert not list(tmp_path.iterdir())
+
+
+def test_inspect_and_rinex_bad_files(tmp_path):
+    (tmp_path / "text.h5").write_text("hello")
+    with h5py.File(tmp_path / "plain.h5", "w") as f:
+        f["x"] = 1
+    assert_clean_error(["inspect", "nope.h5"], tmp_path, "nope.h5: no such file")
+    assert_clean_error(["inspect", "text.h5"], tmp_path, "not an HDF5 file")
+    assert_clean_error(["inspect", "plain.h5"], tmp_path, "not a simkit file")
+    assert_clean_error(["inspect", "."], tmp_path, "is a directory")
+    assert_clean_error(["rinex", "plain.h5"], tmp_path, "not a simkit file")
+    assert_clean_error(["rinex", "text.h5", "-o", "text.h5"], tmp_path, "exists and is not a folder")
+
+
+def test_rinex_of_a_file_without_gnss(tmp_path):
+    import simkit
+
+    simkit.run(tmp_path / _scenario(tmp_path, GOOD), out=tmp_path / "t.h5")
+    assert_clean_error(["rinex", "t.h5", "-o", "rx"], tmp_path, "no /gnss group")
+
+
+def test_unknown_command_and_option(tmp_path):
+    assert_clean_error(["frobnicate"], tmp_path, "invalid choice")
+    assert_clean_error(["run", "quickstart", "--colour"], tmp_path, "unrecognized arguments")
