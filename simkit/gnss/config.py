@@ -96,6 +96,40 @@ def parse_config(sec: Section) -> GnssConfig:
     """Read and validate the [gnss] table (``sec`` at path "gnss"). Raises ScenarioError naming the key."""
     rate = sec.get("rate_hz", float, 1.0, check=positive)
     mask = sec.get("elevation_mask_deg", float, 10.0, check=in_range(-90.0, 90.0))
+    sigs = _signals(sec)
+    sources = [c.get("source", str) for c in _each(sec.sections("constellation", required=True))]
+    if not sources:
+        raise sec.error("constellation", "expected at least one [[gnss.constellation]]")
+    antennas = [_antenna(a) for a in _each(sec.sections("antenna", required=True))]
+    if not antennas:
+        raise sec.error("antenna", "expected at least one [[gnss.antenna]]")
+    clock_mode = sec.get("clock", str, "common", choices=("common", "per_antenna"))
+    osc_name = sec.get("oscillator", str, "tcxo", choices=tuple(clock.PRESETS))
+    err = sec.section("errors")
+    errors = {k: err.get(k, bool, True) for k in ERROR_TERMS}
+    err.done()
+    cfg = GnssConfig(
+        rate_hz=rate, elevation_mask_rad=np.radians(mask), sources=tuple(sources), antennas=tuple(antennas),
+        signals=tuple(sigs), clock_mode=clock_mode, oscillator=clock.PRESETS[osc_name], oscillator_name=osc_name,
+        errors=errors, cn0_zenith_dbhz=sec.get("cn0_zenith_dbhz", float, 45.0, check=in_range(10.0, 70.0)),
+        noise=_noise(sec.section("noise")), multipath=_multipath(sec.section("multipath")),
+        slip_rate_per_h=sec.get("slip_rate_per_h", float, 0.0, check=non_negative),
+        slips=tuple(_slip(s, sigs, len(antennas)) for s in _each(sec.sections("slip"))),
+        outages=tuple(_outage(o, len(antennas)) for o in _each(sec.sections("outage"))),
+        ambiguity_max_cycles=sec.get("ambiguity_max_cycles", int, 100000, check=in_range(0, 10**8)),
+        iono_coefficients=_ionosphere(sec.section("ionosphere")))
+    sec.done()
+    return cfg
+
+
+def _each(sections):
+    """Yield each sub-table, then reject its unknown keys (after the caller read what it knows)."""
+    for s in sections:
+        yield s
+        s.done()
+
+
+def _signals(sec: Section) -> list[str]:
     sigs = sec.get("signals", str, ["L1C"], shape=0)
     if not sigs:
         raise sec.error("signals", "expected at least one signal")
@@ -104,34 +138,19 @@ def parse_config(sec: Section) -> GnssConfig:
             raise sec.error("signals", f"unknown signal {s!r} (known: {', '.join(signals.SIGNALS)})")
     if len(set(sigs)) != len(sigs):
         raise sec.error("signals", f"duplicate signal in {sigs!r}")
+    return sigs
 
-    sources = []
-    for c in sec.sections("constellation", required=True):
-        sources.append(c.get("source", str))
-        c.done()
-    if not sources:
-        raise sec.error("constellation", "expected at least one [[gnss.constellation]]")
 
-    antennas = []
-    for a in sec.sections("antenna", required=True):
-        antennas.append(Antenna(
-            lever_arm_b=np.asarray(a.get("lever_arm_m", float, shape=3)),
-            boresight_b=_unit(a.get("boresight_b", float, [0.0, 0.0, 1.0], shape=3), a, "boresight_b"),
-            horizon_mask_rad=np.radians(a.get("horizon_mask_deg", float, 0.0, check=in_range(-90.0, 90.0))),
-            rolloff_db=a.get("rolloff_db", float, 10.0, check=non_negative)))
-        a.done()
-    if not antennas:
-        raise sec.error("antenna", "expected at least one [[gnss.antenna]]")
+def _antenna(a: Section) -> Antenna:
+    return Antenna(
+        lever_arm_b=np.asarray(a.get("lever_arm_m", float, shape=3)),
+        boresight_b=_unit(a.get("boresight_b", float, [0.0, 0.0, 1.0], shape=3), a, "boresight_b"),
+        horizon_mask_rad=np.radians(a.get("horizon_mask_deg", float, 0.0, check=in_range(-90.0, 90.0))),
+        rolloff_db=a.get("rolloff_db", float, 10.0, check=non_negative))
 
-    clock_mode = sec.get("clock", str, "common", choices=("common", "per_antenna"))
-    osc_name = sec.get("oscillator", str, "tcxo", choices=tuple(clock.PRESETS))
 
-    err = sec.section("errors")
-    errors = {k: err.get(k, bool, True) for k in ERROR_TERMS}
-    err.done()
-
-    nz = sec.section("noise")
-    noise = NoiseConfig(
+def _noise(nz: Section) -> NoiseConfig:
+    cfg = NoiseConfig(
         model=nz.get("model", str, "cn0", choices=("cn0", "constant")),
         code_sigma_m=nz.get("code_sigma_m", float, 0.3, check=non_negative),
         carrier_sigma_m=nz.get("carrier_sigma_m", float, 0.002, check=non_negative),
@@ -142,42 +161,42 @@ def parse_config(sec: Section) -> GnssConfig:
         correlator_spacing_chips=nz.get("correlator_spacing_chips", float, 0.5, check=in_range(0.01, 1.0)),
         integration_time_s=nz.get("integration_time_s", float, 0.02, check=positive))
     nz.done()
+    return cfg
 
-    mp = sec.section("multipath")
-    multipath = MultipathConfig(
+
+def _multipath(mp: Section) -> MultipathConfig:
+    cfg = MultipathConfig(
         code_sigma_m=mp.get("code_sigma_m", float, 1.0, check=non_negative),
         carrier_sigma_m=mp.get("carrier_sigma_m", float, 0.01, check=non_negative),
         elevation_scale_rad=np.radians(mp.get("elevation_scale_deg", float, 20.0, check=positive)),
         correlation_time_s=mp.get("correlation_time_s", float, 30.0, check=positive))
     mp.done()
+    return cfg
 
-    slip_rate = sec.get("slip_rate_per_h", float, 0.0, check=non_negative)
-    slips = []
-    for s in sec.sections("slip"):
-        sig = s.get("signal", str, None)
-        if sig is not None and sig not in sigs:
-            raise s.error("signal", f"must be one of gnss.signals {sigs!r}")
-        ant = s.get("antenna", int, None, check=in_range(0, len(antennas) - 1))
-        cyc = s.get("cycles", int, None)
-        if cyc == 0:
-            raise s.error("cycles", "a slip must be a non-zero number of cycles")
-        slips.append(ScheduledSlip(s.get("t_s", float, check=non_negative), s.get("sat", str, None), ant, sig, cyc))
-        s.done()
 
-    outages = []
-    for o in sec.sections("outage"):
-        start = o.get("start_s", float, check=non_negative)
-        end = o.get("end_s", float, check=lambda v: None if v > start else "must be > start_s")
-        sats = o.get("sats", str, None, shape=0)
-        ants = o.get("antennas", int, None, shape=0)
-        if ants is not None and any(not 0 <= a < len(antennas) for a in ants):
-            raise o.error("antennas", f"antenna indices must be in [0, {len(antennas) - 1}]")
-        outages.append(Outage(start, end, tuple(sats) if sats is not None else None,
-                              tuple(ants) if ants is not None else None))
-        o.done()
+def _slip(s: Section, sigs: list[str], n_antennas: int) -> ScheduledSlip:
+    sig = s.get("signal", str, None)
+    if sig is not None and sig not in sigs:
+        raise s.error("signal", f"must be one of gnss.signals {sigs!r}")
+    ant = s.get("antenna", int, None, check=in_range(0, n_antennas - 1))
+    cyc = s.get("cycles", int, None)
+    if cyc == 0:
+        raise s.error("cycles", "a slip must be a non-zero number of cycles")
+    return ScheduledSlip(s.get("t_s", float, check=non_negative), s.get("sat", str, None), ant, sig, cyc)
 
+
+def _outage(o: Section, n_antennas: int) -> Outage:
+    start = o.get("start_s", float, check=non_negative)
+    end = o.get("end_s", float, check=lambda v: None if v > start else "must be > start_s")
+    sats = o.get("sats", str, None, shape=0)
+    ants = o.get("antennas", int, None, shape=0)
+    if ants is not None and any(not 0 <= a < n_antennas for a in ants):
+        raise o.error("antennas", f"antenna indices must be in [0, {n_antennas - 1}]")
+    return Outage(start, end, tuple(sats) if sats is not None else None, tuple(ants) if ants is not None else None)
+
+
+def _ionosphere(io: Section) -> dict:
     iono = {}
-    io = sec.section("ionosphere")
     for system in ("gps", "bds"):
         a = io.get(f"{system}_alpha", float, None, shape=4)
         b = io.get(f"{system}_beta", float, None, shape=4)
@@ -187,16 +206,7 @@ def parse_config(sec: Section) -> GnssConfig:
         if a is not None:
             iono[system] = (tuple(a), tuple(b))
     io.done()
-
-    cfg = GnssConfig(
-        rate_hz=rate, elevation_mask_rad=np.radians(mask), sources=tuple(sources), antennas=tuple(antennas),
-        signals=tuple(sigs), clock_mode=clock_mode, oscillator=clock.PRESETS[osc_name], oscillator_name=osc_name,
-        errors=errors, cn0_zenith_dbhz=sec.get("cn0_zenith_dbhz", float, 45.0, check=in_range(10.0, 70.0)),
-        noise=noise, multipath=multipath, slip_rate_per_h=slip_rate, slips=tuple(slips), outages=tuple(outages),
-        ambiguity_max_cycles=sec.get("ambiguity_max_cycles", int, 100000, check=in_range(0, 10**8)),
-        iono_coefficients=iono)
-    sec.done()
-    return cfg
+    return iono
 
 
 def check_sats(cfg: GnssConfig, sat_ids) -> None:

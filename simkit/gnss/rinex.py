@@ -72,23 +72,8 @@ def marker_type(antenna_pos_ecef) -> str:
     return "AIRBORNE" if np.ptp(h) > 30.0 else "GROUND_CRAFT"
 
 
-def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, approx_pos_ecef,
-              clock_bias_s=None, marker: str = "SIMKIT", interval_s: float | None = None,
-              kind: str = "GEODETIC") -> Path:
-    """Write one antenna's observations as a RINEX 3.04 observation file.
-
-    ``t`` (M,) s since (start_week, start_sow); ``obs``: signal name -> dict with "code", "carrier", "doppler",
-    "cn0" (M, S) float and "lli" (M, S) uint8 for this antenna; ``clock_bias_s`` (M,) receiver clock bias added
-    to the time tags (None: true GPS time); ``kind`` the MARKER TYPE. Written under a temporary name and
-    renamed when complete. Returns the path.
-    """
-    path = Path(path)
-    t = np.asarray(t, dtype=float)
-    sat_ids = [str(s) for s in sat_ids]
-    systems = sorted({s[0] for s in sat_ids}, key="GCERJI".find)
-    types = _obs_types(obs.keys(), systems)
-    tag = t if clock_bias_s is None else t + np.asarray(clock_bias_s, dtype=float)
-    first, first_frac = _calendar(*gpstime.add_seconds(start_week, start_sow, float(tag[0])))
+def _header(systems, types, first, first_frac, approx_pos_ecef, marker, interval_s, kind) -> str:
+    """The RINEX 3.04 observation header."""
     mixed = "M" if len(types) > 1 else next(iter(types), "G")
     now = datetime.now(timezone.utc).strftime("%Y%m%d %H%M%S UTC")
     head = _hdr(f"{'3.04':>9}{'':11}{'OBSERVATION DATA':<20}{mixed:<20}", "RINEX VERSION / TYPE")
@@ -114,6 +99,27 @@ def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, ap
             if code[0] == "L":
                 head += _hdr(f"{sys} {code} {0.0:8.5f}", "SYS / PHASE SHIFT")
     head += _hdr("", "END OF HEADER")
+    return head
+
+
+def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, approx_pos_ecef,
+              clock_bias_s=None, marker: str = "SIMKIT", interval_s: float | None = None,
+              kind: str = "GEODETIC") -> Path:
+    """Write one antenna's observations as a RINEX 3.04 observation file.
+
+    ``t`` (M,) s since (start_week, start_sow); ``obs``: signal name -> dict with "code", "carrier", "doppler",
+    "cn0" (M, S) float and "lli" (M, S) uint8 for this antenna; ``clock_bias_s`` (M,) receiver clock bias added
+    to the time tags (None: true GPS time); ``kind`` the MARKER TYPE. Written under a temporary name and
+    renamed when complete. Returns the path.
+    """
+    path = Path(path)
+    t = np.asarray(t, dtype=float)
+    sat_ids = [str(s) for s in sat_ids]
+    systems = sorted({s[0] for s in sat_ids}, key="GCERJI".find)
+    types = _obs_types(obs.keys(), systems)
+    tag = t if clock_bias_s is None else t + np.asarray(clock_bias_s, dtype=float)
+    first, first_frac = _calendar(*gpstime.add_seconds(start_week, start_sow, float(tag[0])))
+    head = _header(systems, types, first, first_frac, approx_pos_ecef, marker, interval_s, kind)
 
     # per system: which (signal, field) feeds each obs-type column
     columns = {}
