@@ -15,9 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from simkit import earth, frames, gpstime
+from simkit.constellation import load_sky
 from simkit.constellation.sources import DEFAULT_SKY, resolve
 from simkit.gnss import GnssSimulator, parse_config
-from simkit.scenario.fields import Section
+from simkit.section import Section
 
 SHARED_NAV = Path(__file__).resolve().parents[2] / "shared" / "data" / "rinex_nav" / DEFAULT_SKY
 START = (2416, 86400.0)  # 2026-04-27 00:00 GPST, the day of the BRDM file
@@ -38,7 +39,7 @@ def ours(hours: float, block: int = 600):
                          {"lever_arm_m": [0.0, 9.445, 0.0]}]}
     cfg = parse_config(Section(table, "gnss"))
     t0 = time.perf_counter()
-    sim = GnssSimulator(cfg, *START, seed=1, duration_s=hours * 3600.0)
+    sim = GnssSimulator(cfg, load_sky(cfg.sources), *START, seed=1, duration_s=hours * 3600.0)
     t = sim.epoch_times()
     pos = frames.lla_to_ecef(ORIGIN[0], ORIGIN[1], 400.0)
     rot = frames.attitude_from_euler(0.0, 0.0, 0.5)
@@ -50,7 +51,7 @@ def ours(hours: float, block: int = 600):
         out = sim.process(tb, np.tile(pos, (m, 1)), np.zeros((m, 3)), np.tile(rot.as_quat(), (m, 1)),
                           np.tile(w_ib, (m, 1)))
         for sig in cfg.signals:
-            n_obs += int(np.isfinite(out[f"obs/{sig}/carrier"][0]).sum())
+            n_obs += int(np.isfinite(out.obs[sig].carrier).sum())
         del out
     return time.perf_counter() - t0, t.size, len(sim.sat_ids), n_obs
 
