@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 
 from simkit.imu import ImuSimulator, parse_config
 from simkit.imu.allan import adev
-from simkit.scenario.fields import Section
+from simkit.section import Section
 
 ALL_TERMS = {
     "preset": "stim300",   # turn-on bias, flicker, ARW, scale factor, non-linearity, misalignment, g-sens, range, 262 Hz
