@@ -56,7 +56,8 @@ def run_ours(n, path, compression, all_errors):
             t = np.arange(start, min(n, start + BLOCK)) / RATE
             omega, f = truth_block(t)
             t1 = time.perf_counter()
-            gyro, accel, errors = sim.process(t, omega, f)
+            block = sim.process(t, omega, f)
+            gyro, accel, errors = block.gyro, block.accel, block.errors
             t2 = time.perf_counter()
             kept = errors if all_errors else {k: v for k, v in errors.items() if k.endswith("_bias")}
             arrays = {"imu/gyro": gyro, "imu/accel": accel, **{f"imu/errors/{k}": v for k, v in kept.items()}}

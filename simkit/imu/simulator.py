@@ -11,7 +11,7 @@ Each difference between consecutive stages is one named error term, so output - 
 """
 from __future__ import annotations
 
-import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -22,13 +22,20 @@ from .noise import Flicker, LowPass, Quantizer, RandomWalk, WhiteNoise
 from .vibration import Vibration
 
 
-class ImuBlock(tuple):
-    """``(gyro, accel, errors)`` of one block; ``.increments`` holds {"dtheta", "dvel"} in increments mode."""
+@dataclass(frozen=True)
+class ImuBlock:
+    """One block of IMU output.
 
-    def __new__(cls, gyro, accel, errors, increments):
-        block = super().__new__(cls, (gyro, accel, errors))
-        block.increments = increments
-        return block
+    ``gyro`` (N, 3) rad/s and ``accel`` (N, 3) m/s^2 are the measured rates; ``dtheta`` (N, 3) rad and ``dvel``
+    (N, 3) m/s the measured increments (``imu.output = "increments"``, else None); ``errors`` maps each error
+    term (``gyro_bias``, ``accel_white``, ...) to its (N, 3) true values: gyro - truth = sum of the gyro_* terms.
+    """
+
+    gyro: np.ndarray
+    accel: np.ndarray
+    dtheta: np.ndarray | None
+    dvel: np.ndarray | None
+    errors: dict[str, np.ndarray]
 
 
 def truth_increments(x: np.ndarray, prev: np.ndarray | None, dt: float) -> np.ndarray:
@@ -166,7 +173,7 @@ class ImuSimulator:
         body frame. Returns gyro (N, 3) rad/s, accel (N, 3) m/s^2 and errors {name: (N, 3)} with
         gyro - omega_ib_b == sum of the "gyro_*" terms (likewise accel). In increments mode gyro / accel are the
         measured increments divided by dt, the truth they differ from is the integral of the truth over each
-        interval divided by dt (:func:`truth_increments`), and ``block.increments`` = {"dtheta" rad, "dvel" m/s}.
+        interval divided by dt (:func:`truth_increments`), and ``dtheta`` (rad) / ``dvel`` (m/s) hold them.
         """
         omega = np.asarray(omega_ib_b, dtype=float)
         f = np.asarray(f_ib_b, dtype=float)
@@ -175,8 +182,7 @@ class ImuSimulator:
                              f"{omega.shape}, {f.shape}")
         gyro, gerr, dtheta = self.gyro.process(omega, f)
         accel, aerr, dvel = self.accel.process(f, f)
-        inc = {"dtheta": dtheta, "dvel": dvel} if dtheta is not None else {}
-        return ImuBlock(gyro, accel, {**gerr, **aerr}, inc)
+        return ImuBlock(gyro=gyro, accel=accel, dtheta=dtheta, dvel=dvel, errors={**gerr, **aerr})
 
     def attributes(self) -> dict:
         """Model parameters (resolved preset + overrides, SI units) and the run's random constants, JSON-ready."""
