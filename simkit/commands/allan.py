@@ -82,11 +82,11 @@ def _check_record(n_samples: int, n_gm: int, path):
     if points < need:
         what = f"{len(TERMS)} IEEE terms" + (f" + {n_gm} Gauss-Markov" if n_gm else "")
         raise DataFileError(path, f"record too short: {n_samples} IMU samples give {points} Allan points, fitting "
-                                  f"{what} needs at least {need} (a longer record or a smaller --gauss-markov)")
+                                  f"{what} needs at least {need}" + (" (fewer --gauss-markov terms?)" if n_gm else ""))
 
 
 def _read(args):
-    """(dt, y, preset): the sample interval, the (N, 3) series to analyse and the IMU preset name."""
+    """(dt, y, what, preset): the sample interval, the (N, 3) series to analyse, what it is, the IMU preset."""
     from .. import open as open_file
 
     sensor = args.sensor
@@ -102,12 +102,12 @@ def _read(args):
         if not t01[1] > t01[0]:
             raise DataFileError(args.file, f"/imu/t does not increase ({t01[0]!r}, {t01[1]!r}): no sample rate")
         rate = ds.rate_hz("imu")
-        y = y_arr[:]
+        y, what = y_arr[:], f"/imu/{sensor}"
         truth = TRUTH[sensor]
         if not args.raw and truth in ds and ds[truth].shape == y.shape:
-            y = y - ds[truth][:]
+            y, what = y - ds[truth][:], f"{what} - /{truth}"
         preset = ds.group_attrs("imu", decode_json=True).get("preset", "")
-    return 1.0 / rate, y, preset
+    return 1.0 / rate, y, what, preset
 
 
 def run(args) -> int:
@@ -117,14 +117,14 @@ def run(args) -> int:
     _check_output("--plot", args.plot)
     _check_gauss_markov(args.gauss_markov)
     plt = _pyplot(args.plot) if args.plot else None
-    dt, y, preset = _read(args)
+    dt, y, what, preset = _read(args)
     taus, dev, counts = adev(y, dt)
     flat = [axis for a, axis in enumerate("xyz") if not np.all(np.isfinite(dev[:, a])) or not np.any(dev[:, a] > 0)]
     if flat:
         raise DataFileError(args.file, f"/imu/{args.sensor} axis {', '.join(flat)}: no noise to analyse (zero or "
                                        f"non-finite Allan deviation; an ideal IMU? --raw analyses the measurement)")
     results = {axis: fit(taus, dev[:, a], counts, n_gm=args.gauss_markov) for a, axis in enumerate("xyz")}
-    _print_table(args, dt, y.shape[0], preset, results)
+    _print_table(args.sensor, f"{args.file}: {what}", dt, y.shape[0], preset, results)
     if plt is not None:
         _plot(plt, args.plot, taus, dev, results, args.sensor)
     if args.json:
@@ -135,11 +135,10 @@ def run(args) -> int:
     return 0
 
 
-def _print_table(args, dt, n, preset, results):
+def _print_table(sensor, what, dt, n, preset, results):
     """The fitted terms on stdout; a reader that closes the pipe early (``| head``) ends the output quietly."""
-    units = UNITS[args.sensor]
-    what = f"/imu/{args.sensor}" + ("" if args.raw else f" - /{TRUTH[args.sensor]}")
-    lines = [f"{args.file}: {what}{f' (preset {preset})' if preset else ''}, {n} samples at {1 / dt:g} Hz "
+    units = UNITS[sensor]
+    lines = [f"{what}{f' (preset {preset})' if preset else ''}, {n} samples at {1 / dt:g} Hz "
              f"(IEEE Std 952 terms, two-sided PSD; bias instability B = ADEV floor / 0.664)",
              f"{'axis':>4} " + " ".join(f"{k + ' [' + units[k] + ']':>18}" for k in "QNBKR") + "   Gauss-Markov"]
     for axis, res in results.items():
