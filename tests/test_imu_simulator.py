@@ -189,6 +189,7 @@ def test_allan_command(tmp_path):
     gyro, accel = b.gyro, b.accel
     path = tmp_path / "imu.h5"
     with h5py.File(path, "w") as h5:
+        h5.attrs["schema_version"] = 1     # a simkit file (simkit.open checks it)
         h5["imu/t"], h5["imu/gyro"], h5["imu/accel"] = t, gyro, accel
     parser = argparse.ArgumentParser()
     cmd.add_parser(parser.add_subparsers())
