@@ -1,15 +1,18 @@
-"""Benchmark: truth generation for 1 h at 1 kHz including the HDF5 write (target >= 1,000,000 samples/s,
-peak RSS < 1 GB).
+"""Benchmark: truth generation for 1 h at 1 kHz, with and without the compressed HDF5 write (targets >= 1,000,000
+samples/s with the write, peak RSS < 1 GiB), against gnss-ins-sim's trajectory generator in the same run.
 
-The peer, gnss-ins-sim, is not installable from PyPI here, so the comparison runs a per-sample reference
-generator in the style such tools use (one Python step per sample: Euler-angle kinematics, n-frame velocity and
-position update, gravity), clearly labelled, on a shorter record, and prints the ratio.
-Run: python benchmarks/bench_truth.py [--seconds 3600] [--rate 1000]
+The peer is gnss-ins-sim (github.com/Aceinna/gnss-ins-sim, not on PyPI), imported from the shared peers folder
+(``--peer``; default ``../shared/peers/gnss-ins-sim`` next to the checkout). Its ``pathgen.path_gen`` makes the
+true position, velocity, attitude, body rate and specific force from motion commands, one Python step per sample,
+so it runs on a shorter record of turns, 200 deg/s rolls and a climbing acceleration at the same rate
+(``--peer-seconds``); samples per second is the figure compared. Without the peer only our figures are printed.
+Run: python benchmarks/bench_truth.py [--seconds 3600] [--rate 1000] [--peer-seconds 40]
 """
 from __future__ import annotations
 
 import argparse
 import math
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -17,72 +20,107 @@ from pathlib import Path
 import numpy as np
 import psutil
 
-from simkit import earth
-from simkit.pipeline import run
-from simkit.scenario.loader import load
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # this checkout first
 
-HIGH_DYNAMIC = Path(__file__).resolve().parents[1] / "scenarios" / "high_dynamic.toml"
+from simkit import run  # noqa: E402
+from simkit.scenario.loader import load  # noqa: E402
+from simkit.trajectory import Trajectory  # noqa: E402
 
-
-def per_sample_reference(n: int, rate: float) -> float:
-    """A per-sample loop generator (the architecture of gnss-ins-sim-like tools); returns samples/s."""
-    h = 1.0 / rate
-    lat, lon, hgt = math.radians(40.0), math.radians(116.0), 4000.0
-    v = np.array([100.0, 200.0, 0.0])
-    att = np.zeros(3)
-    t0 = time.perf_counter()
-    for k in range(n):
-        rate_cmd = np.array([0.0, 0.1 * math.sin(k * h), 0.05])
-        att = att + rate_cmd * h
-        rm, rn = earth.radii(lat)
-        g = earth.normal_gravity(lat, hgt)
-        acc = np.array([0.1, 0.0, 0.0])
-        w_ie = np.array([0.0, earth.OMEGA_E * math.cos(lat), earth.OMEGA_E * math.sin(lat)])
-        w_en = np.array([-v[1] / (rm + hgt), v[0] / (rn + hgt), v[0] * math.tan(lat) / (rn + hgt)])
-        f_n = acc + np.cross(2 * w_ie + w_en, v) + np.array([0.0, 0.0, g])
-        c = np.cos(att)
-        s = np.sin(att)
-        _ = np.array([[c[2], -s[2], 0], [s[2], c[2], 0], [0, 0, 1]]) @ f_n
-        v = v + acc * h
-        lat += v[1] / (rm + hgt) * h
-        lon += v[0] / ((rn + hgt) * math.cos(lat)) * h
-        hgt += v[2] * h
-    return n / (time.perf_counter() - t0)
+HIGH_DYNAMIC = ROOT / "scenarios" / "high_dynamic.toml"
+PEER_CANDIDATES = [p / "shared" / "peers" / "gnss-ins-sim" for p in (ROOT.parent, ROOT.parent.parent)]
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seconds", type=float, default=3600.0)
-    ap.add_argument("--rate", type=float, default=1000.0)
-    args = ap.parse_args()
-    sc = load(HIGH_DYNAMIC)
-    data = dict(sc.data)
-    data = {"scenario": dict(data["scenario"], duration_s=args.seconds),
-            "trajectory": dict(data["trajectory"], rate_hz=args.rate)}  # truth only: no IMU / GNSS sections
-    proc = psutil.Process()
-    with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "truth.h5"
-        t0 = time.perf_counter()
-        run(data, out=out)
-        dt = time.perf_counter() - t0
-        n = int(args.seconds * args.rate) + 1
-        size = out.stat().st_size
-    peak = proc.memory_info().rss
+def truth_only_scenario(seconds: float, rate: float) -> dict:
+    data = load(HIGH_DYNAMIC).data
+    return {"scenario": dict(data["scenario"], duration_s=seconds),
+            "trajectory": dict(data["trajectory"], rate_hz=rate)}  # truth only: no IMU / GNSS sections
+
+
+def peak_rss() -> int:
+    peak = psutil.Process().memory_info().rss
     try:
         import resource
 
         peak = max(peak, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
     except ImportError:
         pass
-    ours = n / dt
-    ref = per_sample_reference(20000, args.rate)
-    print(f"simkit truth + HDF5 write: {n} samples in {dt:.2f} s = {ours:,.0f} samples/s "
-          f"(file {size / 1e6:.0f} MB, peak RSS {peak / 2**20:.0f} MiB)")
-    print(f"per-sample loop reference (gnss-ins-sim-style, not installable here): {ref:,.0f} samples/s")
-    print(f"ratio simkit / per-sample reference: {ours / ref:.1f}x")
-    print(f"target >= 1,000,000 samples/s: {'met' if ours >= 1e6 else 'NOT met'}; "
+    return peak
+
+
+def ours(seconds: float, rate: float) -> tuple[float, float, int]:
+    """(samples/s with the HDF5 write, samples/s generation alone, file size in bytes)."""
+    data = truth_only_scenario(seconds, rate)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "truth.h5"
+        t0 = time.perf_counter()
+        run(data, out=out)
+        with_write = time.perf_counter() - t0
+        size = out.stat().st_size
+    sc = load(data)
+    traj = Trajectory(sc.trajectory, sc.duration_s)
+    t0 = time.perf_counter()
+    n = sum(len(block) for block in traj.blocks())
+    alone = time.perf_counter() - t0
+    return n / with_write, n / alone, size
+
+
+def find_peer(path: str | None) -> Path | None:
+    for p in ([Path(path)] if path else PEER_CANDIDATES):
+        if (p / "gnss_ins_sim" / "pathgen" / "pathgen.py").is_file():
+            return p
+    return None
+
+
+def gnss_ins_sim_rate(peer: Path, seconds: float, rate: float) -> float:
+    """gnss-ins-sim's path_gen (NED, 1x over-sampling, no GPS / odometer): samples/s on turns, rolls, a climb."""
+    sys.path.insert(0, str(peer))
+    from gnss_ins_sim.pathgen import pathgen
+
+    d2r = math.pi / 180.0
+    initial = np.array([40.0 * d2r, 116.0 * d2r, 4000.0, 200.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    # type 1 rows: [type, yaw rate, pitch rate, roll rate (deg/s), body accel x, y, z (m/s^2), duration s, gps]
+    cycle = [[1, 0, 0, 0, 0, 0, 0, 2.0, 0], [1, 30, 0, 0, 0, 0, 0, 6.0, 0],
+             [1, 0, 0, 200, 0, 0, 0, 1.8, 0], [1, 0, 5, 0, 1, 0, 0, 3.0, 0]]
+    repeats = max(1, round(seconds / sum(row[7] for row in cycle)))
+    motion = np.array(cycle * repeats, dtype=float)
+    output = np.array([[1.0, rate], [-1.0, rate], [-1.0, rate]])
+    mobility = np.array([10.0, 10.0, 10.0])   # m/s^2, rad/s^2, rad/s: let the commands through unclipped
+    t0 = time.perf_counter()
+    result = pathgen.path_gen(initial, motion, output, mobility, ref_frame=0)
+    elapsed = time.perf_counter() - t0
+    if not result["status"]:
+        raise RuntimeError("gnss-ins-sim path_gen reported failure")
+    return result["nav"].shape[0] / elapsed
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=3600.0)
+    ap.add_argument("--rate", type=float, default=1000.0)
+    ap.add_argument("--peer-seconds", type=float, default=40.0)
+    ap.add_argument("--peer", help="gnss-ins-sim checkout (default: ../shared/peers/gnss-ins-sim)")
+    args = ap.parse_args(argv)
+    with_write, alone, size = ours(args.seconds, args.rate)
+    peak = peak_rss()
+    n = int(args.seconds * args.rate) + 1
+    print(f"simkit truth + HDF5 write, high_dynamic {args.seconds:g} s at {args.rate:g} Hz ({n} samples): "
+          f"{with_write:,.0f} samples/s (file {size / 1e6:.0f} MB, peak RSS {peak / 2**20:.0f} MiB)")
+    print(f"simkit truth generation alone: {alone:,.0f} samples/s")
+    print(f"target >= 1,000,000 samples/s with the write: {'met' if with_write >= 1e6 else 'NOT met'}; "
           f"peak RSS < 1 GiB: {'met' if peak < 2**30 else 'NOT met'}")
+    peer = find_peer(args.peer)
+    if peer is None:
+        print("gnss-ins-sim not found (looked in: " + ", ".join(str(p) for p in PEER_CANDIDATES)
+              + "): no peer figure")
+        return 0
+    theirs = gnss_ins_sim_rate(peer, args.peer_seconds, args.rate)
+    print(f"gnss-ins-sim {peer.name} pathgen.path_gen, {args.peer_seconds:g} s at {args.rate:g} Hz: "
+          f"{theirs:,.0f} samples/s (truth only, in memory)")
+    print(f"ratio simkit / gnss-ins-sim: {alone / theirs:.0f}x generation alone, {with_write / theirs:.0f}x "
+          f"with our HDF5 write")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -1,5 +1,8 @@
 """WGS-84 Earth model: constants, radii of curvature, normal gravity, Earth and transport rates.
 
+Every physical constant simkit uses is defined here once (the ellipsoid, Earth rate, normal gravity, standard
+gravity G0, the speed of light); ``ELLIPSOID`` hands the same ellipsoid to pymap3d.
+
 All angles in radians, heights in metres above the ellipsoid, vectors in the local-level ENU frame (n).
 Gravity follows NIMA TR8350.2: closed-form Somigliana (eq. 4-1) times the height series of eq. 4-3; it
 contains the centrifugal part and acts along minus the ellipsoid normal. Truth and estimators both use it.
@@ -7,6 +10,7 @@ contains the centrifugal part and acts along minus the ellipsoid normal. Truth a
 from __future__ import annotations
 
 import numpy as np
+import pymap3d
 
 A = 6378137.0                      # semi-major axis, m
 F = 1.0 / 298.257223563            # flattening
@@ -18,6 +22,8 @@ GAMMA_E = 9.7803253359             # normal gravity at the equator, m/s^2
 K_SOMIGLIANA = 0.00193185265241    # (b*gamma_p)/(a*gamma_e) - 1
 M_RATIO = OMEGA_E**2 * A**2 * B / GM  # 0.00344978650684
 C_LIGHT = 299792458.0              # m/s
+G0 = 9.80665                       # standard gravity, m/s^2: the unit behind "g", "mg", "ug" and load factors
+ELLIPSOID = pymap3d.Ellipsoid(A, B, name="WGS-84", model="wgs84")  # the same a and b, for pymap3d's geodesy
 
 
 def radii(lat):

@@ -13,21 +13,20 @@ from scipy.spatial.transform import Rotation
 
 from . import earth
 
-_ELL = pymap3d.Ellipsoid.from_name("wgs84")
 # ENU <-> NED and body right-forward-up <-> forward-right-down: the same proper rotation (it is its own inverse)
 SWAP = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 
 
 def lla_to_ecef(lat, lon, h):
     """Geodetic (rad, rad, m) -> ECEF (..., 3) m."""
-    x, y, z = pymap3d.geodetic2ecef(lat, lon, h, ell=_ELL, deg=False)
+    x, y, z = pymap3d.geodetic2ecef(lat, lon, h, ell=earth.ELLIPSOID, deg=False)
     return np.stack(np.broadcast_arrays(x, y, z), axis=-1).astype(float)
 
 
 def ecef_to_lla(pos):
     """ECEF (..., 3) m -> geodetic (..., 3): lat rad, lon rad, ellipsoidal height m."""
     pos = np.asarray(pos, dtype=float)
-    lat, lon, h = pymap3d.ecef2geodetic(pos[..., 0], pos[..., 1], pos[..., 2], ell=_ELL, deg=False)
+    lat, lon, h = pymap3d.ecef2geodetic(pos[..., 0], pos[..., 1], pos[..., 2], ell=earth.ELLIPSOID, deg=False)
     return np.stack(np.broadcast_arrays(lat, lon, h), axis=-1).astype(float)
 
 
@@ -99,8 +98,3 @@ def attitude_from_ned_frd(rot: Rotation) -> Rotation:
     """Body(FRD) -> NED attitude -> body(RFU) -> ENU attitude."""
     return attitude_to_ned_frd(rot)
 
-
-def gravity_ecef(pos_ecef):
-    """WGS-84 normal gravity vector (..., 3) in ECEF at ECEF positions (m/s^2)."""
-    lla = ecef_to_lla(pos_ecef)
-    return enu_to_ecef_vec(earth.gravity_enu(lla[..., 0], lla[..., 2]), lla[..., 0], lla[..., 1])

@@ -18,7 +18,8 @@ def gyro_errors(spec: SensorSpec, rate_hz: float, duration_s: float, seed: int =
     n = int(round(duration_s * rate_hz))
     t = np.arange(n) / rate_hz
     omega = np.zeros((n, 3)) if truth is None else truth(n)
-    gyro, _, errors = ImuSimulator(ImuConfig(gyro=spec), rate_hz, seed).process(t, omega, np.zeros((n, 3)))
+    block = ImuSimulator(ImuConfig(gyro=spec), rate_hz, seed).process(t, omega, np.zeros((n, 3)))
+    gyro, errors = block.gyro, block.errors
     return errors[term] if term else gyro - omega
 
 

@@ -1,5 +1,6 @@
 """ImuSimulator contract: ideal = truth, output - truth = sum of the error terms, block invariance, determinism,
 increments, configuration errors and presets."""
+import dataclasses
 import json
 import math
 
@@ -57,7 +58,8 @@ def test_paper_presets_as_printed():
 def test_ideal_equals_truth():
     t, omega, f = truth(5000)
     for table in ({}, {"preset": "ideal"}):
-        gyro, accel, errors = ImuSimulator(cfg(table), 200.0, 3).process(t, omega, f)
+        b = ImuSimulator(cfg(table), 200.0, 3).process(t, omega, f)
+        gyro, accel, errors = b.gyro, b.accel, b.errors
         assert errors == {}
         np.testing.assert_array_equal(gyro, omega)
         np.testing.assert_array_equal(accel, f)
@@ -65,7 +67,8 @@ def test_ideal_equals_truth():
 
 def test_output_minus_truth_is_sum_of_errors():
     t, omega, f = truth(20000)
-    gyro, accel, errors = ImuSimulator(cfg(ALL_TERMS), 200.0, 3).process(t, omega, f)
+    b = ImuSimulator(cfg(ALL_TERMS), 200.0, 3).process(t, omega, f)
+    gyro, accel, errors = b.gyro, b.accel, b.errors
     assert {"gyro_bias", "gyro_white", "gyro_scale_misalignment", "gyro_g_sensitivity", "gyro_saturation",
             "gyro_quantization", "accel_bias", "accel_white", "accel_scale_misalignment",
             "accel_quantization"} <= set(errors)
@@ -80,7 +83,8 @@ def test_output_minus_truth_is_sum_of_errors():
 
 def test_bandwidth_term_at_high_rate():
     t, omega, f = truth(4000, rate_hz=1000.0)
-    gyro, accel, errors = ImuSimulator(cfg({"preset": "stim300"}), 1000.0, 3).process(t, omega, f)
+    b = ImuSimulator(cfg({"preset": "stim300"}), 1000.0, 3).process(t, omega, f)
+    gyro, accel, errors = b.gyro, b.accel, b.errors
     assert "gyro_bandwidth" in errors and "accel_bandwidth" in errors
     total = sum(v for k, v in errors.items() if k.startswith("gyro_"))
     np.testing.assert_allclose(gyro - omega, total, rtol=0, atol=1e-14)
@@ -94,12 +98,12 @@ def test_blocks_give_identical_arrays(output):
     sim = ImuSimulator(c, 200.0, 42)
     cuts = [0, 1, 2, 7, 1000, 1001, 6000, 12345]
     parts = [sim.process(t[a:b], omega[a:b], f[a:b]) for a, b in zip(cuts[:-1], cuts[1:])]
-    for i in range(2):
-        np.testing.assert_array_equal(one[i], np.concatenate([p[i] for p in parts]))
-    for name in one[2]:
-        np.testing.assert_array_equal(one[2][name], np.concatenate([p[2][name] for p in parts]))
-    for name in one.increments:
-        np.testing.assert_array_equal(one.increments[name], np.concatenate([p.increments[name] for p in parts]))
+    arrays = ("gyro", "accel") + (("dtheta", "dvel") if output == "increments" else ())
+    assert (one.dtheta is None) == (output == "rates")
+    for name in arrays:
+        np.testing.assert_array_equal(getattr(one, name), np.concatenate([getattr(p, name) for p in parts]))
+    for name in one.errors:
+        np.testing.assert_array_equal(one.errors[name], np.concatenate([p.errors[name] for p in parts]))
 
 
 def test_deterministic_and_seed_dependent():
@@ -107,8 +111,8 @@ def test_deterministic_and_seed_dependent():
     a = ImuSimulator(cfg(ALL_TERMS), 200.0, 5).process(t, omega, f)
     b = ImuSimulator(cfg(ALL_TERMS), 200.0, 5).process(t, omega, f)
     c = ImuSimulator(cfg(ALL_TERMS), 200.0, 6).process(t, omega, f)
-    np.testing.assert_array_equal(a[0], b[0])
-    assert not np.array_equal(a[0], c[0])
+    np.testing.assert_array_equal(a.gyro, b.gyro)
+    assert not np.array_equal(a.gyro, c.gyro)
 
 
 def test_changing_accel_does_not_change_gyro_noise():
@@ -116,7 +120,7 @@ def test_changing_accel_does_not_change_gyro_noise():
     other = {**ALL_TERMS, "accel": {"vrw_m_per_s_per_sqrt_h": 1.0}}
     a = ImuSimulator(cfg(ALL_TERMS), 200.0, 5).process(t, omega, f)
     b = ImuSimulator(cfg(other), 200.0, 5).process(t, omega, f)
-    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a.gyro, b.gyro)
 
 
 def test_truth_increments_exact_for_quadratics():
@@ -134,11 +138,14 @@ def test_truth_increments_exact_for_quadratics():
 def test_increments_output():
     t, omega, f = truth(3000)
     block = ImuSimulator(cfg({**ALL_TERMS, "output": "increments"}), 200.0, 9).process(t, omega, f)
-    gyro, accel, errors = block
+    assert [f.name for f in dataclasses.fields(block)] == ["gyro", "accel", "dtheta", "dvel", "errors"]
+    assert not isinstance(block, tuple)
+    gyro, errors = block.gyro, block.errors
     dt = 1 / 200.0
-    np.testing.assert_allclose(block.increments["dtheta"] / dt, gyro, rtol=1e-15)
+    np.testing.assert_allclose(block.dtheta / dt, gyro, rtol=1e-15)
+    np.testing.assert_allclose(block.dvel / dt, block.accel, rtol=1e-15)
     q = 0.5e-6
-    k = block.increments["dtheta"] / q
+    k = block.dtheta / q
     np.testing.assert_allclose(k, np.round(k), atol=1e-6)     # whole LSBs
     total = sum(v for n, v in errors.items() if n.startswith("gyro_"))
     np.testing.assert_allclose(gyro - truth_increments(omega, None, dt) / dt, total, rtol=0, atol=1e-12)
@@ -178,9 +185,11 @@ def test_allan_command(tmp_path):
     rate, n = 100.0, 60000
     t = np.arange(n) / rate
     c = cfg({"gyro": {"arw_deg_per_sqrt_h": 0.5}})
-    gyro, accel, _ = ImuSimulator(c, rate, 1).process(t, np.zeros((n, 3)), np.zeros((n, 3)))
+    b = ImuSimulator(c, rate, 1).process(t, np.zeros((n, 3)), np.zeros((n, 3)))
+    gyro, accel = b.gyro, b.accel
     path = tmp_path / "imu.h5"
     with h5py.File(path, "w") as h5:
+        h5.attrs["schema_version"] = 1     # a simkit file (simkit.open checks it)
         h5["imu/t"], h5["imu/gyro"], h5["imu/accel"] = t, gyro, accel
     parser = argparse.ArgumentParser()
     cmd.add_parser(parser.add_subparsers())

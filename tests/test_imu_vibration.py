@@ -47,9 +47,9 @@ def vibration(n, blocks=1, seed=7):
     if blocks > 1:   # uneven cuts, including tiny ones
         cuts = np.unique(np.concatenate([cuts, [1, 2, 3, 17, n // 3 + 5]]))
     out = [sim.process(t[a:b], zeros[a:b], zeros[a:b]) for a, b in zip(cuts[:-1], cuts[1:])]
-    acc = np.concatenate([o[1] for o in out])
-    gyro = np.concatenate([o[0] for o in out])
-    errs = {k: np.concatenate([o[2][k] for o in out]) for k in out[0][2]}
+    acc = np.concatenate([o.accel for o in out])
+    gyro = np.concatenate([o.gyro for o in out])
+    errs = {k: np.concatenate([o.errors[k] for o in out]) for k in out[0].errors}
     return gyro, acc, errs
 
 
@@ -112,13 +112,14 @@ def test_with_other_terms_error_identity_holds():
     t = np.arange(n) / RATE
     omega = np.stack([0.1 * np.sin(t), 0.2 * np.cos(t), 0.05 + 0 * t], axis=1)
     f = np.stack([0.5 * np.sin(2 * t), 0 * t, 9.8 + 0 * t], axis=1)
-    gyro, accel, errors = sim.process(t, omega, f)
+    block = sim.process(t, omega, f)
+    accel, errors = block.accel, block.errors
     assert "accel_vibration" in errors and "gyro_vibration" not in errors
     np.testing.assert_allclose(accel - f, sum(v for k, v in errors.items() if k.startswith("accel_")),
                                atol=1e-12)
     # enabling vibration does not change the other terms' noise (own random stream)
     base = ImuSimulator(cfg({"preset": "stim300", "accel": {"bandwidth_hz": 262.0}}), RATE, 3).process(t, omega, f)
-    np.testing.assert_array_equal(base[2]["accel_bias"], errors["accel_bias"])
+    np.testing.assert_array_equal(base.errors["accel_bias"], errors["accel_bias"])
 
 
 def test_default_off():

@@ -102,3 +102,25 @@ def test_bad_segments_name_the_key(segment, key, text):
     with pytest.raises(ScenarioError) as err:
         _run([segment])
     assert f"trajectory.{key}" in str(err.value) and text in str(err.value)
+
+
+@pytest.mark.filterwarnings("ignore::scipy.integrate.IntegrationWarning")  # quad at its roundoff limit
+@pytest.mark.parametrize("duration,ramp,period", [(12.0, 1.0, 6.0), (7.3, 2.1, 2.5), (0.8, 0.4, 6.0),
+                                                  (10.0, 5.0, 3.3), (3.0, 1.0, 0.07)])
+def test_weave_heading_change_closed_form_matches_quadrature(duration, ramp, period):
+    from scipy.integrate import quad
+
+    from simkit.trajectory.profiles import Sinusoid
+
+    w = Sinusoid(2.0, duration, min(ramp, duration / 2), 0.3, period)
+    breaks = np.arange(w.start, w.end, period / 4)[1:]
+    ref, err = quad(lambda t: w.evaluate(t)[0], w.start, w.end, points=breaks, limit=2000, epsabs=1e-15)
+    assert w.integral() == pytest.approx(ref, abs=1e-14 + 10 * err)
+
+
+def test_weave_then_waypoints_enter_along_the_flown_heading():
+    """The planner's heading after a weave (closed form) is the one the generator flies, so the waypoint spline
+    starts along the actual velocity: no step in the body rate at the join."""
+    sc, tr = _run([{"kind": "weave", "heading_amplitude_deg": 25.0, "period_s": 7.0, "cycles": 1.3},
+                   {"kind": "waypoints", "points_enu_m": [[1000.0, 1500.0, 0.0], [3000.0, 2000.0, 0.0]]}])
+    _assert_smooth(tr, 200.0)

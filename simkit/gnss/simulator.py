@@ -28,7 +28,7 @@ from . import atmosphere, noise, signals as sigmod
 from .clock import ClockProcess
 from .config import GnssConfig, check_sats
 from .draws import KeyedNormals
-from .multipath import GaussMarkov, elevation_scale
+from .multipath import elevation_scale, multipath_bank
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
 
@@ -70,7 +70,7 @@ class GnssSimulator:
                        for a in range(n_clk)]
         sys_signals = [np.flatnonzero([g.system == sys for g in self.signals]) for sys in self.system]
         self.draws = KeyedNormals(seed, self.n_ant, self.sat_ids, sys_signals, len(self.signals))
-        self.mp = GaussMarkov(self.dt, cfg.multipath.correlation_time_s,
+        self.mp = multipath_bank(self.dt, cfg.multipath.correlation_time_s,
                               (self.n_ant, len(self.sat_ids), len(self.signals), 2))
         self.tracking = Tracking(cfg, seed, self.sat_ids, self.n_ant)
         self.vis = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)
@@ -194,7 +194,7 @@ class _Parts:
         self.az = np.where(np.isfinite(view.azimuth), view.azimuth, 0.0)
         self._troposphere(err)
         self._ionosphere(err, sow)
-        self.mp = sim.mp.advance(draws[..., 3:5], restart, cand) if err["multipath"] else None
+        self.mp = sim.mp.advance(draws[..., 3:5], restart, index=(slice(None), cand)) if err["multipath"] else None
         amb, lli = sim.tracking.advance(t, tracked)
         self.obs, self.signal_truth = {}, {}
         for j, g in enumerate(sim.signals):

@@ -20,6 +20,14 @@ FLICKER_FLOOR = math.sqrt(2.0 * math.log(2.0) / math.pi)  # 0.6643: ADEV floor p
 TERMS = ("Q", "N", "B", "K", "R")
 
 
+def default_multiples(n: int, per_decade: int = 10) -> np.ndarray:
+    """The averaging times, in samples, of :func:`adev` by default for ``n`` samples: ``per_decade`` log-spaced
+    whole multiples m of the interval, 1 <= m <= (n - 1) / 2 (n >= 3)."""
+    m_max = (n - 1) // 2
+    grid = np.logspace(0, math.log10(m_max), max(2, int(per_decade * math.log10(m_max)) + 1))
+    return np.unique(np.round(grid)).astype(np.int64)
+
+
 def adev(y: np.ndarray, dt: float, taus=None, per_decade: int = 10):
     """Overlapping Allan deviation of rate samples ``y`` ((N,) or (N, k), one series per column) at interval dt.
 
@@ -33,12 +41,10 @@ def adev(y: np.ndarray, dt: float, taus=None, per_decade: int = 10):
     n = y2.shape[0]
     if n < 3:
         raise ValueError("need at least 3 samples for an Allan deviation")
-    m_max = (n - 1) // 2
     if taus is None:
-        m = np.unique(np.round(np.logspace(0, math.log10(m_max), max(2, int(per_decade * math.log10(m_max)) + 1))))
+        m = default_multiples(n, per_decade)
     else:
-        m = np.unique(np.clip(np.round(np.asarray(taus, dtype=float) / dt), 1, m_max))
-    m = m.astype(np.int64)
+        m = np.unique(np.clip(np.round(np.asarray(taus, dtype=float) / dt), 1, (n - 1) // 2)).astype(np.int64)
     x = np.zeros((n + 1, y2.shape[1]))
     np.cumsum(y2 - y2.mean(axis=0), axis=0, out=x[1:])
     out = np.empty((m.size, y2.shape[1]))

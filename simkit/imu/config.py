@@ -11,12 +11,12 @@ import tomllib
 from dataclasses import asdict, dataclass, field
 from importlib import resources
 
+from ..earth import G0  # standard gravity: the unit behind "g", "mg" and "ug" in datasheets
 from ..errors import ScenarioError
 from ..section import Section, non_negative, positive
 
 DEG = math.pi / 180.0
 HOUR = 3600.0
-G0 = 9.80665  # standard gravity, the unit behind "g", "mg" and "ug" in datasheets
 OUTPUTS = ("rates", "increments")
 IDEAL = "ideal"
 

@@ -3,7 +3,8 @@
 Each generator draws from its own random stream in sample-major order and carries its state between blocks, so a
 record cut into any blocks is bit-identical to the record made in one call. A sample represents the interval
 (t[k-1], t[k]] of length ``dt``; every discretisation below is exact (or accurate to O(dt/tau)) for the continuous
-process, so the same physical spec gives the same Allan deviation at any sample rate.
+process, so the same physical spec gives the same Allan deviation at any sample rate. The first-order
+Gauss-Markov bias terms use the bank shared with the GNSS multipath, :class:`simkit.processes.GaussMarkov`.
 """
 from __future__ import annotations
 
@@ -44,22 +45,6 @@ class RandomWalk:
         steps = self.step * self.rng.standard_normal((count, self.value.shape[1]))
         out = np.cumsum(np.concatenate([self.value, steps]), axis=0)[1:]
         self.value = out[-1:].copy()
-        return out
-
-
-class GaussMarkov:
-    """First-order Gauss-Markov process (sigma, tau), exact AR(1) discretisation, started stationary."""
-
-    def __init__(self, sigma: float, tau: float, dt: float, rng: np.random.Generator, axes: int = 3):
-        self.phi = math.exp(-dt / tau)
-        self.drive = sigma * math.sqrt(-math.expm1(-2.0 * dt / tau))
-        self.rng = rng
-        self.state = sigma * rng.standard_normal((1, axes))
-
-    def block(self, count: int) -> np.ndarray:
-        w = self.drive * self.rng.standard_normal((count, self.state.shape[1]))
-        out, zi = signal.lfilter([1.0], [1.0, -self.phi], w, axis=0, zi=self.phi * self.state)
-        self.state = out[-1:].copy()
         return out
 
 

@@ -11,27 +11,31 @@ Each difference between consecutive stages is one named error term, so output - 
 """
 from __future__ import annotations
 
-import math
-
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..processes import GaussMarkov
 from ..rng import generator
 from .config import VIBRATION_KEYS, ImuConfig, SensorSpec
-from .noise import Flicker, GaussMarkov, LowPass, Quantizer, RandomWalk, WhiteNoise
+from .noise import Flicker, LowPass, Quantizer, RandomWalk, WhiteNoise
 from .vibration import Vibration
 
 
 @dataclass(frozen=True)
 class ImuBlock:
-    """TEMPORARY (replaced by the IMU refactor)."""
+    """One block of IMU output.
+
+    ``gyro`` (N, 3) rad/s and ``accel`` (N, 3) m/s^2 are the measured rates; ``dtheta`` (N, 3) rad and ``dvel``
+    (N, 3) m/s the measured increments (``imu.output = "increments"``, else None); ``errors`` maps each error
+    term (``gyro_bias``, ``accel_white``, ...) to its (N, 3) true values: gyro - truth = sum of the gyro_* terms.
+    """
 
     gyro: np.ndarray
     accel: np.ndarray
     dtheta: np.ndarray | None
     dvel: np.ndarray | None
-    errors: dict
+    errors: dict[str, np.ndarray]
 
 
 def truth_increments(x: np.ndarray, prev: np.ndarray | None, dt: float) -> np.ndarray:
@@ -89,7 +93,7 @@ class _Sensor:
             self.bias_sources.append(RandomWalk(s.rate_random_walk, dt, rng("rate_random_walk")))
         for i, gm in enumerate(s.gauss_markov):
             if gm.sigma > 0:
-                self.bias_sources.append(GaussMarkov(gm.sigma, gm.tau_s, dt, rng("gauss_markov", str(i))))
+                self.bias_sources.append(GaussMarkov(gm.sigma, gm.tau_s, dt, (3,), rng("gauss_markov", str(i))))
         self.white = WhiteNoise(s.random_walk, dt, rng("white")) if s.random_walk > 0 else None
         self.vibration = (Vibration(np.array(s.vibration_psd), dt, rng("vibration"),
                                     f"imu.{name}.{VIBRATION_KEYS[name][0]}") if s.vibration_psd else None)
@@ -169,7 +173,7 @@ class ImuSimulator:
         body frame. Returns gyro (N, 3) rad/s, accel (N, 3) m/s^2 and errors {name: (N, 3)} with
         gyro - omega_ib_b == sum of the "gyro_*" terms (likewise accel). In increments mode gyro / accel are the
         measured increments divided by dt, the truth they differ from is the integral of the truth over each
-        interval divided by dt (:func:`truth_increments`), and ``block.increments`` = {"dtheta" rad, "dvel" m/s}.
+        interval divided by dt (:func:`truth_increments`), and ``dtheta`` (rad) / ``dvel`` (m/s) hold them.
         """
         omega = np.asarray(omega_ib_b, dtype=float)
         f = np.asarray(f_ib_b, dtype=float)
@@ -178,8 +182,7 @@ class ImuSimulator:
                              f"{omega.shape}, {f.shape}")
         gyro, gerr, dtheta = self.gyro.process(omega, f)
         accel, aerr, dvel = self.accel.process(f, f)
-        inc = {"dtheta": dtheta, "dvel": dvel} if dtheta is not None else {}
-        return ImuBlock(gyro, accel, inc.get("dtheta"), inc.get("dvel"), {**gerr, **aerr})
+        return ImuBlock(gyro=gyro, accel=accel, dtheta=dtheta, dvel=dvel, errors={**gerr, **aerr})
 
     def attributes(self) -> dict:
         """Model parameters (resolved preset + overrides, SI units) and the run's random constants, JSON-ready."""
