@@ -84,7 +84,7 @@ def _records(rows, system, ref_sow):
 def _gps():
     week, sow = gpstime.utc_to_gps(GPS_EPOCH_UTC)
     rate = _j2_node_rate(GPS_A, GPS_INC, GPS.mu)
-    n = 0.5 * (GPS.omega_e - rate)
+    n = 2.0 * (GPS.omega_e - rate)  # 2 revolutions per day relative to the precessing node
     rows = [(f"G{k + 1:02d}", GPS_A, GPS_INC, (raan - GPS_GHA_DEG) * DEG, u * DEG, n, rate)
             for k, (raan, u) in enumerate(GPS_SLOTS.values())]
     return week, _records(rows, GPS, sow)
