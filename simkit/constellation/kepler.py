@@ -38,7 +38,7 @@ def empty_table(n: int) -> np.ndarray:
     return np.zeros((n, len(FIELDS)))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _eccentric_anomaly(m, e):
     """Kepler's equation E - e sin E = M by Newton from E = M: (E, converged). Not converged: the last step after
     KEPLER_MAX_ITERATIONS is larger than KEPLER_TOL * max(1, |M|) (a NaN M never converges)."""
@@ -52,7 +52,7 @@ def _eccentric_anomaly(m, e):
     return ecc_anom, abs(d) <= KEPLER_TOL * max(1.0, abs(m))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _orbit(p, tk, n, ecc_anom, want_vel):
     """Position and velocity (x, y, z, vx, vy, vz) of record ``p`` at tk s from toe, for eccentric anomaly
     ``ecc_anom`` and corrected mean motion ``n``: ECEF, or for a BDS GEO the frame before the GEO rotation.
@@ -92,7 +92,7 @@ def _orbit(p, tk, n, ecc_anom, want_vel):
     return x, y, z, vx, vy, vz
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _geo_rotation(x, y, z, vx, vy, vz, om_e, tk, want_vel):
     """BDS GEO: R_X(-5 deg) then R_Z(Omega_e tk), both as defined in the BDS ICD (velocity with the frame rate)."""
     c_tilt, s_tilt = math.cos(GEO_TILT), math.sin(GEO_TILT)
@@ -133,7 +133,7 @@ def _propagate(params, idx, t, want_vel, pos, clk, vel, drift):
         _store(k, x, y, z, clock, vx, vy, vz, rate, want_vel, pos, clk, vel, drift)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _store(k, x, y, z, clock, vx, vy, vz, rate, want_vel, pos, clk, vel, drift):
     pos[k, 0], pos[k, 1], pos[k, 2] = x, y, z
     clk[k] = clock
@@ -142,7 +142,7 @@ def _store(k, x, y, z, clock, vx, vy, vz, rate, want_vel, pos, clk, vel, drift):
         drift[k] = rate
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _store_nan(k, want_vel, pos, clk, vel, drift):
     _store(k, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, want_vel, pos, clk, vel, drift)
 
