@@ -24,12 +24,11 @@ from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M, SYSTEMS
 from .textfile import lines_of, number, read_bytes
 
 N_FIELDS = 31  # af0 af1 af2 + 7 lines x 4 broadcast-orbit values
-WEEK = gpstime.SECONDS_PER_WEEK
+SECONDS_PER_WEEK = gpstime.SECONDS_PER_WEEK
 # positions within the 31 values (RINEX 3.04 Tables A6 and A14; RINEX 4.00 LNAV/D1/D2 are identical)
 AF0, AF1, AF2, IODE, CRS, DN, M0, CUC, E, CUS, SQRTA, TOE, CIC, OMEGA0, CIS, I0, CRC, OMEGA, OMEGADOT, IDOT, \
-    CODES, GPS_WEEK, L2P, ACC, HEALTH, TGD1, TGD2 = range(27)
-_REQUIRED = {SQRTA: "sqrt(A)", E: "eccentricity", I0: "i0", OMEGA0: "OMEGA0", TOE: "toe", GPS_WEEK: "week",
-             M0: "M0"}
+    CODES, WEEK, L2P, ACC, HEALTH, TGD1, TGD2 = range(27)
+_REQUIRED = {SQRTA: "sqrt(A)", E: "eccentricity", I0: "i0", OMEGA0: "OMEGA0", TOE: "toe", WEEK: "week", M0: "M0"}
 # lines per RINEX 3 record by system (GLONASS gained a line in 3.05); other letters are not checked
 _RINEX3_LINES = {"G": (8,), "C": (8,), "E": (8,), "J": (8,), "I": (8,), "R": (4, 5), "S": (4,)}
 _CNV_DELAYS = {"CNV1": {24: "ISC_B1Cd", 26: "TGD_B1Cp", 27: "TGD_B2ap"},
@@ -250,10 +249,10 @@ def build(ids, vals, source, klob, cnav_delays, path) -> KeplerConstellation:
     offs = np.where(is_bds, SYSTEMS["C"].time_offset_s, 0.0)
     week_off = np.where(is_bds, SYSTEMS["C"].week_offset, 0)
     toc_abs = vals[:, N_FIELDS] + offs
-    toe_abs = (vals[:, GPS_WEEK] + week_off) * WEEK + vals[:, TOE] + offs
-    toe_abs += WEEK * np.round((toc_abs - toe_abs) / WEEK)
-    ref_week = int(np.floor(toe_abs.min() / WEEK))
-    t0 = ref_week * WEEK
+    toe_abs = (vals[:, WEEK] + week_off) * SECONDS_PER_WEEK + vals[:, TOE] + offs
+    toe_abs += SECONDS_PER_WEEK * np.round((toc_abs - toe_abs) / SECONDS_PER_WEEK)
+    ref_week = int(np.floor(toe_abs.min() / SECONDS_PER_WEEK))
+    t0 = ref_week * SECONDS_PER_WEEK
     n = len(ids)
     p = kepler.empty_table(n)
     c = kepler.COL
