@@ -4,6 +4,8 @@
    (georinex reads the same .gz directly, restricted to GPS + BDS like simkit).
 2. Satellite states: broadcast-ephemeris positions + clocks for many satellite-epochs vs skyfield's SGP4
    (EarthSatellite.at(...).frame_xyz(itrs), same satellite-epoch count).
+3. ``simkit sky`` working memory per satellite-epoch (tracemalloc peak of the geometry and DOPs), the figure
+   behind its memory estimate (``simkit.commands.sky.BYTES_PER_SAT_EPOCH``).
 
 Run: python benchmarks/bench_constellation.py
 """
@@ -72,6 +74,28 @@ def bench_states():
           f"(timed on {n_full:,}; ratio {(n / ours) / (n_full / full):.0f}x)")
 
 
+def bench_sky_memory():
+    import argparse
+    import tracemalloc
+
+    from simkit.commands import sky
+
+    args = argparse.Namespace(lat=34.25, lon=108.95, height=400.0, mask=10.0)
+    m = 4000
+    sow = 86400.0 + np.arange(m) * (86400.0 / m)
+    print(f"sky working memory ({m} epochs; the estimate uses {sky.BYTES_PER_SAT_EPOCH} B per satellite-epoch):")
+    for source in (sc.DEFAULT_SKY, "nominal:gps"):
+        const = sc.load(source)
+        sky._compute(const, args, 2416, sow[:10])  # JIT warm-up outside the trace
+        tracemalloc.start()
+        sky._compute(const, args, 2416, sow)
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        print(f"  {source}: {len(const)} satellites, peak {peak / 2**20:.1f} MiB = "
+              f"{peak / (m * len(const)):.0f} B per satellite-epoch")
+
+
 if __name__ == "__main__":
     bench_parse()
     bench_states()
+    bench_sky_memory()

@@ -16,6 +16,11 @@ GPS_EPOCH = datetime(1980, 1, 6, tzinfo=timezone.utc)
 GPS_MINUS_TAI = -19.0
 BDT_MINUS_GPST = -14.0
 BDS_WEEK_OFFSET = 1356
+SECONDS_PER_DAY = 86400.0
+UNIX_EPOCH_JD = 2440587.5                                                     # 1970-01-01 00:00 as a Julian date
+GPS_EPOCH_JD = UNIX_EPOCH_JD + GPS_EPOCH.timestamp() / SECONDS_PER_DAY        # 2444244.5: 1980-01-06 00:00
+GPS_EPOCH_ORDINAL = GPS_EPOCH.date().toordinal()                              # proleptic Gregorian day number
+ALMANAC_ROLLOVER_WEEKS = 1024                                                 # 10-bit broadcast week numbers
 
 
 @lru_cache(maxsize=1)

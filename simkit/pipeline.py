@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from . import gpstime
-from .constellation import Sky, load_sky
+from .constellation import NoStateError, Sky, load_sky
 from .errors import DataFileError, OutputError, ScenarioError
 from .gnss import GnssSimulator
 from .imu import ImuSimulator
@@ -115,26 +115,17 @@ def _check_sky_covers_run(sc: Scenario, sky: Sky, origin: np.ndarray) -> None:
     ``origin`` (3,) m ECEF during the run (sampled every minute)."""
     t = np.linspace(0.0, sc.duration_s, int(min(sc.duration_s // _SKY_CHECK_STEP_S, _SKY_CHECK_MAX)) + 2)
     week, sow = gpstime.add_seconds(sc.start_week, sc.start_sow, t)
+    for i, const in enumerate(sky.constellations):
+        try:
+            const.require_states(week, sow)
+        except NoStateError as exc:
+            raise ScenarioError(f"gnss.constellation[{i}].source", str(exc), sc.source) from None
     with np.errstate(invalid="ignore"):
         el = sky.view(np.broadcast_to(origin, (t.size, 3)), week, sow)["elevation"]
-    sources = ", ".join(sky.sources)
-    if not np.isfinite(el).any():
-        raise ScenarioError("gnss.constellation", f"{sources} gives no satellite state between "
-                            f"{sc.start.isoformat()} and +{sc.duration_s:g} s ({_coverage(sky)})", sc.source)
     mask = sc.gnss.elevation_mask_rad
     if not (el >= mask).any():
-        raise ScenarioError("gnss.elevation_mask_deg", f"no satellite of {sources} rises above "
+        raise ScenarioError("gnss.elevation_mask_deg", f"no satellite of {', '.join(sky.sources)} rises above "
                             f"{np.degrees(mask):g} deg at the origin during the run", sc.source)
-
-
-def _coverage(sky: Sky) -> str:
-    spans = []
-    for c in sky.constellations:
-        span = getattr(c, "validity_span", None)
-        if callable(span):
-            first, last = span()
-            spans.append(f"{c.source} covers {first} to {last}")
-    return "; ".join(spans) or "check the source's dates"
 
 
 def _rows(prefix: str, obj) -> dict[str, np.ndarray]:

@@ -79,22 +79,31 @@ def test_light_time_range_elevation_azimuth_and_dops_match_rtklib():
     sow = 86400.0 + np.arange(0.0, 86400.0, 3600.0)
     rx = np.repeat(XIAN[None], sow.size, 0)
     g = receiver_view(c, rx, 2416, sow)
-    # satellite at emission in the ECEF frame of emission, for RTKLIB's geodist (first-order Sagnac)
-    p_tx, _ = c.state_each(g.tx_week, g.tx_sow)
+    # RTKLIB's geodist takes the satellite at emission in the ECEF frame of emission (as satposs returns it) and
+    # adds the Sagnac term to first order: on sat_pos_emission it must give our range; on sat_pos (already
+    # rotated into the reception frame) it would count Earth rotation twice
     lla = frames.ecef_to_lla(XIAN)
     pos_arr = _rtklib_arr(lla)
     e = pyrtklib.Arr1Ddouble(3)
     azel = pyrtklib.Arr1Ddouble(2)
-    d_rng = d_ang = 0.0
+    d_rng = d_ang = d_twice = 0.0
+    kinds = set()
     for m in range(sow.size):
         for s in np.flatnonzero(np.isfinite(g.range[m])):
-            r = pyrtklib.geodist(_rtklib_arr(p_tx[m, s]), _rtklib_arr(XIAN), e)
+            r = pyrtklib.geodist(_rtklib_arr(g.sat_pos_emission[m, s]), _rtklib_arr(XIAN), e)
             d_rng = max(d_rng, abs(r - g.range[m, s]))
+            d_twice = max(d_twice, abs(pyrtklib.geodist(_rtklib_arr(g.sat_pos[m, s]), _rtklib_arr(XIAN), e)
+                                       - g.range[m, s]))
+            kinds.add(c.orbit_type[s])
             pyrtklib.satazel(pos_arr, _rtklib_arr(g.los[m, s]), azel)
             d_ang = max(d_ang, abs(azel[1] - g.elevation[m, s]),
                         abs(np.mod(azel[0] - g.azimuth[m, s] + np.pi, 2 * np.pi) - np.pi))
-    print(f"vs RTKLIB geodist: max |drange| {d_rng * 1e3:.3f} mm; satazel: max |dangle| {d_ang:.1e} rad")
-    assert d_rng < 2e-3 and d_ang < 1e-9
+    print(f"vs RTKLIB geodist on sat_pos_emission: max |drange| {d_rng * 1e3:.3f} mm (on sat_pos: "
+          f"{d_twice:.1f} m); satazel: max |dangle| {d_ang:.1e} rad")
+    assert kinds == {"MEO", "IGSO", "GEO"}
+    assert d_rng < 1e-3 and d_ang < 1e-9 and d_twice > 1.0
+    assert g.sat_pos_emission.shape == g.sat_pos.shape
+    np.testing.assert_array_equal(np.isnan(g.sat_pos_emission), np.isnan(g.sat_pos))
     mask = np.radians(10.0)
     ours = dops(g.elevation, g.azimuth, mask)
     dop = pyrtklib.Arr1Ddouble(4)

@@ -120,7 +120,7 @@ def test_nominal_gps_reproduces_the_published_slot_table():
     from simkit import gpstime
 
     c = load("nominal:gps")
-    week, sow = gpstime.utc_to_gps(nominal.GPS_EPOCH_UTC)
+    week, sow = gpstime.utc_to_gps(nominal.SPS_TABLE_EPOCH_UTC)
     pos, _, vel, _ = c.state(week, sow, velocity=True)
     # angular momentum of the osculating plane: inertial velocity without the J2 node regression
     rate = nominal._j2_node_rate(nominal.GPS_A, nominal.GPS_INC, 3.986005e14)

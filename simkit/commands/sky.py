@@ -1,9 +1,28 @@
-"""``simkit sky SOURCE --lat .. --lon .. --start ..``: visible satellites and DOPs over time, and a sky plot."""
+"""``simkit sky SOURCE --lat .. --lon .. --start ..``: visible satellites and DOPs over time, and a sky plot.
+
+Bad input ends in one line on stderr and exit code 2, checked before any computing: ranges of every number, the
+plot's folder and matplotlib, the working memory the span needs (``--force`` to go beyond
+:data:`MEMORY_LIMIT_BYTES`), and a sky with no satellite (times the source does not cover, or a mask nothing
+clears). Output into a closed pipe (``| head``) ends quietly.
+"""
 from __future__ import annotations
+
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import ScenarioError
+
+MEMORY_LIMIT_BYTES = 2 * 1024**3
+# working memory of the geometry and DOPs: tracemalloc peak 206 B per satellite-epoch (67 and 24 satellites x
+# 4000 epochs), rounded up; the per-epoch part covers the time arrays. `python benchmarks/bench_constellation.py`
+BYTES_PER_SAT_EPOCH = 256
+BYTES_PER_EPOCH = 64
+HEIGHT_RANGE_M = (-11000.0, 20.0e6)  # deepest ocean floor .. below the GNSS orbits
 
 
 def add_parser(sub):
@@ -13,52 +32,169 @@ def add_parser(sub):
                                    "and print visible counts and DOPs per step; optionally save a sky plot.")
     p.add_argument("source", nargs="?", default=None,
                    help="constellation source (default: the bundled 2026 BRDM broadcast file)")
-    p.add_argument("--lat", type=float, required=True, help="latitude, deg")
-    p.add_argument("--lon", type=float, required=True, help="longitude, deg")
-    p.add_argument("--height", type=float, default=0.0, help="ellipsoidal height, m (default 0)")
+    p.add_argument("--lat", type=float, required=True, help="geodetic latitude, deg (-90..90)")
+    p.add_argument("--lon", type=float, required=True, help="longitude, deg (-180..360)")
+    p.add_argument("--height", type=float, default=0.0,
+                   help="ellipsoidal height, m (default 0; -11000 m to 20,000 km)")
     p.add_argument("--start", required=True, help="UTC start, ISO 8601 (e.g. 2026-04-27T06:00:00Z)")
-    p.add_argument("--hours", type=float, default=2.0, help="span, h (default 2)")
-    p.add_argument("--step", type=float, default=600.0, help="step, s (default 600)")
-    p.add_argument("--mask", type=float, default=10.0, help="elevation mask, deg (default 10)")
+    p.add_argument("--hours", type=float, default=2.0, help="span, h (>= 0, default 2)")
+    p.add_argument("--step", type=float, default=600.0, help="step, s (> 0, default 600)")
+    p.add_argument("--mask", type=float, default=10.0, help="elevation mask, deg (-90..90, default 10)")
     p.add_argument("--validity-days", type=float, default=None,
                    help="almanac/TLE sources: days either side of their epoch with valid states (default 7)")
-    p.add_argument("--plot", metavar="OUT.png", help="save a sky plot (needs matplotlib)")
+    p.add_argument("--plot", metavar="OUT.png", help="save a sky plot (needs matplotlib: the 'plot' extra)")
+    p.add_argument("--force", action="store_true",
+                   help=f"compute even when the span needs more than {MEMORY_LIMIT_BYTES / 1024**3:g} GiB")
     return p
 
 
 def run(args) -> int:
-    from .. import frames, gpstime
+    from .. import gpstime
     from .. import constellation as sc
 
-    try:
-        start = gpstime.parse_utc(args.start)
-    except ValueError:
-        raise ScenarioError("--start", f"expected an ISO 8601 UTC time, got {args.start!r}") from None
-    if args.step <= 0 or args.hours < 0:
-        raise ScenarioError("--step", "the step must be > 0 s and the span >= 0 h")
+    _check_numbers(args)
+    plot_format = _check_plot(args.plot) if args.plot else None
+    start = _start(args.start)
     const = sc.load(args.source or sc.DEFAULT_SKY, validity_days=args.validity_days)
     week, sow0 = gpstime.utc_to_gps(start)
-    sow = sow0 + np.arange(0.0, args.hours * 3600.0 + 1e-9, args.step)
+    sow = sow0 + np.arange(_step_count(args, len(const))) * args.step
+    const.require_states(week, sow)  # NoStateError: names the source and the span it covers
+    geo, vis, d = _compute(const, args, week, sow)
+    out = _Output()
+    _print_table(out, const, args, week, sow, vis, d)
+    if args.plot:
+        _sky_plot(args.plot, plot_format, const, geo, vis,
+                  f"{const.source} from {args.lat:.2f}, {args.lon:.2f}, {args.start}")
+        out.line(f"sky plot written to {args.plot}")
+    return 0
+
+
+def _check_numbers(args):
+    """Each numeric option finite and in range, else one ScenarioError naming the option."""
+    limits = {"--lat": (args.lat, -90.0, 90.0, "deg"), "--lon": (args.lon, -180.0, 360.0, "deg"),
+              "--height": (args.height, *HEIGHT_RANGE_M, "m"), "--mask": (args.mask, -90.0, 90.0, "deg")}
+    for name, (value, lo, hi, unit) in limits.items():
+        if not (math.isfinite(value) and lo <= value <= hi):
+            raise ScenarioError(name, f"found {value:g}; expected {lo:g} to {hi:g} {unit}")
+    if not (math.isfinite(args.hours) and args.hours >= 0):
+        raise ScenarioError("--hours", f"found {args.hours:g}; expected a span >= 0 h")
+    if not (math.isfinite(args.step) and args.step > 0):
+        raise ScenarioError("--step", f"found {args.step:g}; expected a step > 0 s")
+    days = args.validity_days
+    if days is not None and not (math.isfinite(days) and days > 0):
+        raise ScenarioError("--validity-days", f"found {days:g}; expected a number of days > 0")
+
+
+def _check_plot(path_text: str) -> str:
+    """Before any computing: the plot's folder exists and is writable, matplotlib imports and knows the file
+    type. Returns the file type (the extension)."""
+    path = Path(path_text)
+    folder = path.parent
+    if not folder.is_dir():
+        raise ScenarioError("--plot", f"folder {str(folder)!r} does not exist (create it first)")
+    if not os.access(folder, os.W_OK):
+        raise ScenarioError("--plot", f"folder {str(folder)!r} is not writable")
+    try:
+        from matplotlib.backend_bases import FigureCanvasBase
+    except ImportError:
+        raise ScenarioError("--plot", "needs matplotlib, which is not installed: pip install 'simkit[plot]' "
+                            "(the 'plot' extra)") from None
+    kinds = FigureCanvasBase.get_supported_filetypes()
+    kind = path.suffix.lower().lstrip(".")
+    if kind not in kinds:
+        raise ScenarioError("--plot", f"cannot tell the image type of {path.name!r}: expected a file name ending "
+                            f"in {', '.join('.' + k for k in sorted(kinds))}")
+    return kind
+
+
+def _start(text: str):
+    from .. import gpstime
+
+    try:
+        start = gpstime.parse_utc(text)
+    except ValueError:
+        raise ScenarioError("--start", f"expected an ISO 8601 UTC time, got {text!r}") from None
+    if start < gpstime.GPS_EPOCH:
+        raise ScenarioError("--start", f"{text!r} is before the GPS epoch {gpstime.GPS_EPOCH:%Y-%m-%d}")
+    return start
+
+
+def _step_count(args, n_sats: int) -> int:
+    """Number of epochs in the span; ScenarioError when they would need more than MEMORY_LIMIT_BYTES (unless
+    --force)."""
+    steps = math.floor(args.hours * 3600.0 / args.step + 1e-9) + 1
+    need = steps * (n_sats * BYTES_PER_SAT_EPOCH + BYTES_PER_EPOCH)
+    if need > MEMORY_LIMIT_BYTES and not args.force:
+        raise ScenarioError("--hours", f"{args.hours:g} h at --step {args.step:g} s is {steps:,} epochs x "
+                            f"{n_sats} satellites, about {_size(need)} of working memory (limit "
+                            f"{_size(MEMORY_LIMIT_BYTES)}): shorten --hours, lengthen --step, or pass --force")
+    return steps
+
+
+def _size(n_bytes: float) -> str:
+    for unit, scale in (("TiB", 1024**4), ("GiB", 1024**3), ("MiB", 1024**2)):
+        if n_bytes >= scale:
+            return f"{n_bytes / scale:.3g} {unit}"
+    return f"{n_bytes / 1024:.3g} KiB"
+
+
+def _compute(const, args, week, sow):
+    """Geometry, visibility (M, S) and DOPs; ScenarioError when no satellite clears the mask at any step."""
+    from .. import frames
+    from .. import constellation as sc
+    from ..constellation.model import describe_span
+
     rx = frames.lla_to_ecef(np.radians(args.lat), np.radians(args.lon), args.height)
     geo = sc.receiver_view(const, np.broadcast_to(rx, (sow.size, 3)), week, sow)
     mask = np.radians(args.mask)
     vis = sc.geometry.visible(geo.elevation, mask)
-    d = sc.dops(geo.elevation, geo.azimuth, mask, const.system)
-    print(f"{const.source}: {len(const)} satellites ({const.kind}); site {args.lat:.4f}, {args.lon:.4f}, "
-          f"{args.height:g} m; mask {args.mask:g} deg; one receiver clock per system")
+    if not vis.any():
+        first, last = (const.validity_span(week, s) for s in (sow[0], sow[-1]))
+        raise ScenarioError("--mask", f"no satellite of {const.source} is at or above {args.mask:g} deg at any "
+                            f"step from {_utc(week, sow[0])} to {_utc(week, sow[-1])} (the source covers "
+                            f"{describe_span(first)})")
+    return geo, vis, sc.dops(geo.elevation, geo.azimuth, mask, const.system)
+
+
+def _utc(week, sow) -> str:
+    from .. import gpstime
+
+    return gpstime.gps_to_utc(week, sow).strftime("%Y-%m-%d %H:%M:%S UTC")
+
+
+def _print_table(out, const, args, week, sow, vis, d):
+    out.line(f"{const.source}: {len(const)} satellites ({const.kind}); site {args.lat:.4f}, {args.lon:.4f}, "
+             f"{args.height:g} m; mask {args.mask:g} deg; one receiver clock per system")
     systems = sorted(set(const.system.tolist()))
-    print("UTC                  " + " ".join(f"{s:>3}" for s in systems) + "  all   GDOP   PDOP   HDOP   VDOP")
+    out.line("UTC                  " + " ".join(f"{s:>3}" for s in systems) + "  all   GDOP   PDOP   HDOP   VDOP")
     for m in range(sow.size):
-        utc = gpstime.gps_to_utc(week, sow[m]).strftime("%Y-%m-%d %H:%M:%S")
+        if out.closed:
+            return
         counts = " ".join(f"{int(vis[m, const.system == s].sum()):3d}" for s in systems)
-        print(f"{utc}  {counts}  {int(vis[m].sum()):3d} " + " ".join(f"{d[k][m]:6.2f}" for k in "GPHV"))
-    if args.plot:
-        _sky_plot(args.plot, const, geo, vis, f"{const.source} from {args.lat:.2f}, {args.lon:.2f}, {args.start}")
-        print(f"sky plot written to {args.plot}")
-    return 0
+        out.line(f"{_utc(week, sow[m])[:19]}  {counts}  {int(vis[m].sum()):3d} "
+                 + " ".join(f"{d[k][m]:6.2f}" for k in "GPHV"))
 
 
-def _sky_plot(path, const, geo, vis, title):
+class _Output:
+    """Lines to stdout; when the reader goes away (``| head``) the rest is dropped quietly: stdout is pointed at
+    os.devnull so that neither this writer nor the interpreter's final flush raises BrokenPipeError."""
+
+    def __init__(self):
+        self.closed = False
+
+    def line(self, text: str):
+        if self.closed:
+            return
+        try:
+            print(text, flush=True)
+        except BrokenPipeError:
+            self.closed = True
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            os.close(devnull)
+
+
+def _sky_plot(path, kind, const, geo, vis, title):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -78,5 +214,20 @@ def _sky_plot(path, const, geo, vis, title):
         ax.plot(az, el, ".", ms=3, color=colors.get(sid[0], "k"))
         ax.annotate(f"{sid} {const.orbit_type[s][0]}", (az[-1], el[-1]), fontsize=7)
     ax.set_title(title, fontsize=9)
-    fig.savefig(path, dpi=120)
+    _save_atomically(fig, Path(path), kind)
     plt.close(fig)
+
+
+def _save_atomically(fig, path: Path, kind: str):
+    """Write under a temporary name in the same folder and rename: a failure never leaves a partial image."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            fig.savefig(f, format=kind, dpi=120)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 -> what open() would have given
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import gpstime
 from ..errors import DataFileError
 from . import kepler
 from .model import KeplerConstellation, Records
 from .systems import GPS
 from .textfile import number
 
-ROLLOVER_S = 1024 * 604800.0
+ROLLOVER_S = gpstime.ALMANAC_ROLLOVER_WEEKS * gpstime.SECONDS_PER_WEEK
 DEFAULT_VALIDITY_DAYS = 7.0
 _YUMA_KEYS = {  # label prefix (lower case) -> field
     "id": "prn", "health": "health", "eccentricity": "e", "time of applicability": "toa",
@@ -45,7 +46,7 @@ def _kepler_rows(rows, path):
     for k, r in enumerate(rows):
         if not (r["sqrt_a"] > 0 and 0 <= r["e"] < 1):
             raise DataFileError(path, f"PRN {r['prn']}: sqrt(A) must be > 0 and 0 <= e < 1", r["line"])
-        t = r["week"] * 604800.0 + r["toa"]
+        t = r["week"] * gpstime.SECONDS_PER_WEEK + r["toa"]
         p[k, c["toe"]] = p[k, c["toc"]] = t
         p[k, c["toe_sow"]] = r["toa"]
         for name in ("sqrt_a", "e", "i0", "omega0", "omega", "m0", "omega_dot", "af0", "af1"):
@@ -65,7 +66,7 @@ def _constellation(rows, path, kind, validity_days):
     p = _kepler_rows(rows, path)
     n = len(rows)
     records = Records(p, np.arange(n), np.array([r["health"] == 0 for r in rows]),
-                      np.full(n, validity_days * 86400.0), np.full(n, ROLLOVER_S))
+                      np.full(n, validity_days * gpstime.SECONDS_PER_DAY), np.full(n, ROLLOVER_S))
     return KeplerConstellation([f"G{r['prn']:02d}" for r in rows], records, str(path), 0, kind)
 
 
@@ -131,7 +132,7 @@ def from_ephemeris(const: KeplerConstellation, gps_week: int, gps_sow: float,
     (gps_week, gps_sow), propagated with the almanac model (Keplerian with the record's own secular terms:
     mean-motion correction delta_n and OMEGA_DOT kept; harmonic corrections, IDOT and af2 dropped), valid
     ``validity_days`` either side. Satellites with no healthy record are left out."""
-    t = (gps_week - const.ref_week) * 604800.0 + gps_sow
+    t = gpstime.diff_seconds(gps_week, gps_sow, const.ref_week, 0.0)
     keep, rows = [], []
     c = kepler.COL
     toe = const.records.params[:, c["toe"]]
@@ -145,9 +146,7 @@ def from_ephemeris(const: KeplerConstellation, gps_week: int, gps_sow: float,
     p = const.records.params[rows].copy()
     p[:, [c[k] for k in ("cuc", "cus", "crc", "crs", "cic", "cis", "idot", "af2")]] = 0.0
     n = len(rows)
-    records = Records(p, np.arange(n), np.ones(n, bool), np.full(n, validity_days * 86400.0))
+    records = Records(p, np.arange(n), np.ones(n, bool), np.full(n, validity_days * gpstime.SECONDS_PER_DAY))
     out = KeplerConstellation(keep, records, f"almanac from {const.source}", const.ref_week, "almanac")
     out.orbit_type = const.orbit_type[[const.sat_ids.index(s) for s in keep]]
     return out
-
-

@@ -1,8 +1,10 @@
 """What receivers see of a constellation: light time with Earth rotation, ranges, line of sight, elevation and
 azimuth, elevation mask, DOPs and visible counts. Vectorised over epochs (M) x satellites (S).
 
-Frames: satellite positions are returned in the ECEF frame *at reception time*: the position at emission time
-(ECEF of that instant) rotated about z by Omega_e * tau (Sagnac / Earth-rotation correction), tau the light time.
+Frames: ``Geometry.sat_pos`` is the satellite position at emission time rotated about z by Omega_e * tau into the
+ECEF frame *at reception time* (Sagnac / Earth-rotation correction, tau the light time); ``sat_pos_emission`` is the
+same position left in the ECEF frame *of the emission epoch*, as RTKLIB's ``satposs`` returns it and as
+``/gnss/sat_pos_ecef`` stores it (a user adds the Sagnac term).
 """
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from ..earth import C_LIGHT, OMEGA_E
 from .model import Constellation
 
 LIGHT_TIME_ITERATIONS = 3  # each iteration shrinks the error by ~v_sat/c: 3 take 75 ms to < 1e-9 m
+TAU_START_S = 0.075  # start of the iteration: about a MEO's light time (20,000 km)
 
 
 @dataclass
@@ -23,7 +26,8 @@ class Geometry:
 
     ``tx_week`` (M, S) int and ``tx_sow`` (M, S) s: GPS emission time (reception minus geometric light time).
     ``sat_pos`` (M, S, 3) m and ``sat_vel`` (M, S, 3) m/s (None unless asked): satellite at emission, in the ECEF
-    frame of reception. ``sat_clock`` (M, S) s and ``sat_drift`` (M, S) s/s at emission. ``range`` (M, S) m
+    frame of reception. ``sat_pos_emission`` (M, S, 3) m: the same position in the ECEF frame of the emission
+    epoch (unrotated; RTKLIB ``satposs`` convention, DESIGN's ``/gnss/sat_pos_ecef``). ``sat_clock`` (M, S) s and ``sat_drift`` (M, S) s/s at emission. ``range`` (M, S) m
     geometric distance, ``tau`` (M, S) s light time, ``los`` (M, S, 3) unit vectors receiver -> satellite (ECEF),
     ``elevation`` and ``azimuth`` (M, S) rad (azimuth clockwise from north in [0, 2 pi)).
     """
@@ -39,7 +43,7 @@ class Geometry:
     los: np.ndarray
     elevation: np.ndarray
     azimuth: np.ndarray
-    sat_pos_emission: np.ndarray | None = None  # TEMPORARY
+    sat_pos_emission: np.ndarray
 
 
 def _rotate_z(vec, angle):
@@ -61,14 +65,8 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
     m, s = sow.size, len(const.sat_ids)
     if rx.shape != (m, 3):
         rx = np.broadcast_to(rx, (m, 3))
-    tau = np.full((m, s), 0.075)
     week_ms = np.broadcast_to(week[:, None], (m, s))
-    for _ in range(LIGHT_TIME_ITERATIONS):
-        tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
-        pos = const.state_each(tw, ts)[0]
-        rot = _rotate_z(pos, OMEGA_E * tau)
-        tau = np.linalg.norm(rot - rx[:, None, :], axis=-1) / C_LIGHT
-        tau = np.where(np.isfinite(tau), tau, 0.075)  # no state: keep a finite time, the state stays NaN
+    tau = _light_time(const, rx, week_ms, sow)
     tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
     out = const.state_each(tw, ts, velocity=velocity)
     pos = _rotate_z(out[0], OMEGA_E * tau)
@@ -76,10 +74,24 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
     rng = np.linalg.norm(diff, axis=-1)
     los = diff / rng[..., None]
     el, az = elevation_azimuth(rx, los)
-    vel = _rotate_z(out[2], OMEGA_E * tau) if velocity else None
-    ts = np.where(np.isfinite(rng), ts, np.nan)
-    return Geometry(np.asarray(tw), ts, pos, vel, out[1], out[3] if velocity else None,
-                    rng, rng / C_LIGHT, los, el, az, out[0])
+    return Geometry(
+        tx_week=np.asarray(tw), tx_sow=np.where(np.isfinite(rng), ts, np.nan), sat_pos=pos,
+        sat_vel=_rotate_z(out[2], OMEGA_E * tau) if velocity else None, sat_clock=out[1],
+        sat_drift=out[3] if velocity else None, range=rng, tau=rng / C_LIGHT, los=los, elevation=el, azimuth=az,
+        sat_pos_emission=out[0],
+    )
+
+
+def _light_time(const, rx, week_ms, sow):
+    """Light time tau (M, S) s after LIGHT_TIME_ITERATIONS fixed-point steps tau = |R_z(Omega_e tau) r(t - tau)
+    - rx| / c; satellites without a state keep the start value (their state stays NaN)."""
+    tau = np.full(week_ms.shape, TAU_START_S)
+    for _ in range(LIGHT_TIME_ITERATIONS):
+        tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
+        rot = _rotate_z(const.state_each(tw, ts)[0], OMEGA_E * tau)
+        tau = np.linalg.norm(rot - rx[:, None, :], axis=-1) / C_LIGHT
+        tau = np.where(np.isfinite(tau), tau, TAU_START_S)
+    return tau
 
 
 def elevation_azimuth(rx_pos, los):

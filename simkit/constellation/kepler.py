@@ -22,6 +22,15 @@ FIELDS = (
 )
 COL = {name: k for k, name in enumerate(FIELDS)}
 GEO_TILT = -5.0 * math.pi / 180.0
+KEPLER_MAX_ITERATIONS = 30
+KEPLER_STOP = 1e-14  # Newton step (rad) that ends the iteration
+KEPLER_TOL = 1e-13   # rad per unit |M| (RTKLIB's RTOL_KEPLER): a larger last step after 30 iterations is a failure
+# column numbers as module constants (numba compiles them in; a dict lookup cannot run inside the kernel)
+_TOE, _TOC, _SQRT_A, _E, _I0, _OMEGA0, _OMEGA, _M0, _DELTA_N, _IDOT, _OMEGA_DOT = (
+    COL[k] for k in ("toe", "toc", "sqrt_a", "e", "i0", "omega0", "omega", "m0", "delta_n", "idot", "omega_dot"))
+_CUC, _CUS, _CRC, _CRS, _CIC, _CIS, _AF0, _AF1, _AF2 = (
+    COL[k] for k in ("cuc", "cus", "crc", "crs", "cic", "cis", "af0", "af1", "af2"))
+_TOE_SOW, _MU, _OMEGA_E, _REL_F, _GEO = (COL[k] for k in ("toe_sow", "mu", "omega_e", "rel_f", "geo"))
 
 
 def empty_table(n: int) -> np.ndarray:
@@ -29,109 +38,122 @@ def empty_table(n: int) -> np.ndarray:
     return np.zeros((n, len(FIELDS)))
 
 
+@numba.njit(cache=True, inline="always")
+def _eccentric_anomaly(m, e):
+    """Kepler's equation E - e sin E = M by Newton from E = M: (E, converged). Not converged: the last step after
+    KEPLER_MAX_ITERATIONS is larger than KEPLER_TOL * max(1, |M|) (a NaN M never converges)."""
+    ecc_anom = m
+    d = np.inf
+    for _ in range(KEPLER_MAX_ITERATIONS):
+        d = (ecc_anom - e * math.sin(ecc_anom) - m) / (1.0 - e * math.cos(ecc_anom))
+        ecc_anom -= d
+        if abs(d) < KEPLER_STOP:
+            break
+    return ecc_anom, abs(d) <= KEPLER_TOL * max(1.0, abs(m))
+
+
+@numba.njit(cache=True, inline="always")
+def _orbit(p, tk, n, ecc_anom, want_vel):
+    """Position and velocity (x, y, z, vx, vy, vz) of record ``p`` at tk s from toe, for eccentric anomaly
+    ``ecc_anom`` and corrected mean motion ``n``: ECEF, or for a BDS GEO the frame before the GEO rotation.
+    The velocity (zeros unless ``want_vel``) is the analytic derivative of the same formulas."""
+    a = p[_SQRT_A] * p[_SQRT_A]
+    e = p[_E]
+    s_e, c_e = math.sin(ecc_anom), math.cos(ecc_anom)
+    one_m_ecos = 1.0 - e * c_e
+    sq1e2 = math.sqrt(1.0 - e * e)
+    phi = math.atan2(sq1e2 * s_e, c_e - e) + p[_OMEGA]
+    s2, c2 = math.sin(2.0 * phi), math.cos(2.0 * phi)
+    u = phi + p[_CUS] * s2 + p[_CUC] * c2
+    r = a * one_m_ecos + p[_CRS] * s2 + p[_CRC] * c2
+    inc = p[_I0] + p[_CIS] * s2 + p[_CIC] * c2 + p[_IDOT] * tk
+    # a GEO's node is propagated without Earth rotation (the rotation comes with the GEO tilt)
+    node_rate = p[_OMEGA_DOT] if p[_GEO] != 0.0 else p[_OMEGA_DOT] - p[_OMEGA_E]
+    node = p[_OMEGA0] + node_rate * tk - p[_OMEGA_E] * p[_TOE_SOW]
+    c_u, s_u = math.cos(u), math.sin(u)
+    xp, yp = r * c_u, r * s_u
+    c_o, s_o = math.cos(node), math.sin(node)
+    c_i, s_i = math.cos(inc), math.sin(inc)
+    x = xp * c_o - yp * c_i * s_o
+    y = xp * s_o + yp * c_i * c_o
+    z = yp * s_i
+    if not want_vel:
+        return x, y, z, 0.0, 0.0, 0.0
+    e_dot = n / one_m_ecos
+    phi_dot = e_dot * sq1e2 / one_m_ecos
+    u_dot = phi_dot * (1.0 + 2.0 * (p[_CUS] * c2 - p[_CUC] * s2))
+    r_dot = a * e * s_e * e_dot + 2.0 * phi_dot * (p[_CRS] * c2 - p[_CRC] * s2)
+    i_dot = p[_IDOT] + 2.0 * phi_dot * (p[_CIS] * c2 - p[_CIC] * s2)
+    xp_dot = r_dot * c_u - yp * u_dot
+    yp_dot = r_dot * s_u + xp * u_dot
+    vx = xp_dot * c_o - yp_dot * c_i * s_o + yp * s_i * s_o * i_dot - y * node_rate
+    vy = xp_dot * s_o + yp_dot * c_i * c_o - yp * s_i * c_o * i_dot + x * node_rate
+    vz = yp_dot * s_i + yp * c_i * i_dot
+    return x, y, z, vx, vy, vz
+
+
+@numba.njit(cache=True, inline="always")
+def _geo_rotation(x, y, z, vx, vy, vz, om_e, tk, want_vel):
+    """BDS GEO: R_X(-5 deg) then R_Z(Omega_e tk), both as defined in the BDS ICD (velocity with the frame rate)."""
+    c_tilt, s_tilt = math.cos(GEO_TILT), math.sin(GEO_TILT)
+    y1 = c_tilt * y + s_tilt * z
+    z1 = -s_tilt * y + c_tilt * z
+    c_t, s_t = math.cos(om_e * tk), math.sin(om_e * tk)
+    gx = c_t * x + s_t * y1
+    gy = -s_t * x + c_t * y1
+    if not want_vel:
+        return gx, gy, z1, 0.0, 0.0, 0.0
+    vy1 = c_tilt * vy + s_tilt * vz
+    vz1 = -s_tilt * vy + c_tilt * vz
+    return gx, gy, z1, c_t * vx + s_t * vy1 + om_e * gy, -s_t * vx + c_t * vy1 - om_e * gx, vz1
+
+
 @numba.njit(cache=True, parallel=True)
 def _propagate(params, idx, t, want_vel, pos, clk, vel, drift):
-    c_tilt = math.cos(GEO_TILT)
-    s_tilt = math.sin(GEO_TILT)
     for k in numba.prange(idx.shape[0]):  # independent elements: results do not depend on the thread count
-        r_i = idx[k]
-        if r_i < 0:
-            pos[k, 0] = np.nan
-            pos[k, 1] = np.nan
-            pos[k, 2] = np.nan
-            clk[k] = np.nan
-            if want_vel:
-                vel[k, 0] = np.nan
-                vel[k, 1] = np.nan
-                vel[k, 2] = np.nan
-                drift[k] = np.nan
+        if idx[k] < 0:  # no valid record
+            _store_nan(k, want_vel, pos, clk, vel, drift)
             continue
-        p = params[r_i]
-        mu = p[21]
-        om_e = p[22]
-        a = p[2] * p[2]
-        e = p[3]
-        tk = t[k] - p[0]
-        n = math.sqrt(mu / (a * a * a)) + p[8]
-        m = p[7] + n * tk
-        ecc_anom = m
-        for _ in range(30):
-            d = (ecc_anom - e * math.sin(ecc_anom) - m) / (1.0 - e * math.cos(ecc_anom))
-            ecc_anom -= d
-            if abs(d) < 1e-14:
-                break
-        s_e = math.sin(ecc_anom)
+        p = params[idx[k]]
+        tk = t[k] - p[_TOE]
+        a = p[_SQRT_A] * p[_SQRT_A]
+        n = math.sqrt(p[_MU] / (a * a * a)) + p[_DELTA_N]
+        ecc_anom, converged = _eccentric_anomaly(p[_M0] + n * tk, p[_E])
+        if not converged:
+            _store_nan(k, want_vel, pos, clk, vel, drift)
+            continue
+        x, y, z, vx, vy, vz = _orbit(p, tk, n, ecc_anom, want_vel)
+        if p[_GEO] != 0.0:
+            x, y, z, vx, vy, vz = _geo_rotation(x, y, z, vx, vy, vz, p[_OMEGA_E], tk, want_vel)
+        dtc = t[k] - p[_TOC]
+        rel = p[_REL_F] * p[_E] * p[_SQRT_A]
+        clock = p[_AF0] + p[_AF1] * dtc + p[_AF2] * dtc * dtc + rel * math.sin(ecc_anom)
         c_e = math.cos(ecc_anom)
-        one_m_ecos = 1.0 - e * c_e
-        sq1e2 = math.sqrt(1.0 - e * e)
-        phi = math.atan2(sq1e2 * s_e, c_e - e) + p[6]
-        s2 = math.sin(2.0 * phi)
-        c2 = math.cos(2.0 * phi)
-        u = phi + p[12] * s2 + p[11] * c2
-        r = a * one_m_ecos + p[14] * s2 + p[13] * c2
-        inc = p[4] + p[16] * s2 + p[15] * c2 + p[9] * tk
-        geo = p[24] != 0.0
-        if geo:
-            node_rate = p[10]
-        else:
-            node_rate = p[10] - om_e
-        node = p[5] + node_rate * tk - om_e * p[20]
-        c_u = math.cos(u)
-        s_u = math.sin(u)
-        xp = r * c_u
-        yp = r * s_u
-        c_o = math.cos(node)
-        s_o = math.sin(node)
-        c_i = math.cos(inc)
-        s_i = math.sin(inc)
-        x = xp * c_o - yp * c_i * s_o
-        y = xp * s_o + yp * c_i * c_o
-        z = yp * s_i
-        if want_vel:
-            e_dot = n / one_m_ecos
-            phi_dot = e_dot * sq1e2 / one_m_ecos
-            u_dot = phi_dot * (1.0 + 2.0 * (p[12] * c2 - p[11] * s2))
-            r_dot = a * e * s_e * e_dot + 2.0 * phi_dot * (p[14] * c2 - p[13] * s2)
-            i_dot = p[9] + 2.0 * phi_dot * (p[16] * c2 - p[15] * s2)
-            xp_dot = r_dot * c_u - yp * u_dot
-            yp_dot = r_dot * s_u + xp * u_dot
-            vx = xp_dot * c_o - yp_dot * c_i * s_o + yp * s_i * s_o * i_dot - y * node_rate
-            vy = xp_dot * s_o + yp_dot * c_i * c_o - yp * s_i * c_o * i_dot + x * node_rate
-            vz = yp_dot * s_i + yp * c_i * i_dot
-        if geo:
-            # R_X(-5 deg) then R_Z(Omega_e tk), both as defined in the BDS ICD
-            y1 = c_tilt * y + s_tilt * z
-            z1 = -s_tilt * y + c_tilt * z
-            th = om_e * tk
-            c_t = math.cos(th)
-            s_t = math.sin(th)
-            gx = c_t * x + s_t * y1
-            gy = -s_t * x + c_t * y1
-            x, y, z = gx, gy, z1
-            if want_vel:
-                vy1 = c_tilt * vy + s_tilt * vz
-                vz1 = -s_tilt * vy + c_tilt * vz
-                gvx = c_t * vx + s_t * vy1 + om_e * y
-                gvy = -s_t * vx + c_t * vy1 - om_e * x
-                vx, vy, vz = gvx, gvy, vz1
-        pos[k, 0] = x
-        pos[k, 1] = y
-        pos[k, 2] = z
-        dtc = t[k] - p[1]
-        rel = p[23] * e * p[2]
-        clk[k] = p[17] + p[18] * dtc + p[19] * dtc * dtc + rel * s_e
-        if want_vel:
-            vel[k, 0] = vx
-            vel[k, 1] = vy
-            vel[k, 2] = vz
-            drift[k] = p[18] + 2.0 * p[19] * dtc + rel * c_e * e_dot
+        rate = p[_AF1] + 2.0 * p[_AF2] * dtc + rel * c_e * (n / (1.0 - p[_E] * c_e))
+        _store(k, x, y, z, clock, vx, vy, vz, rate, want_vel, pos, clk, vel, drift)
+
+
+@numba.njit(cache=True, inline="always")
+def _store(k, x, y, z, clock, vx, vy, vz, rate, want_vel, pos, clk, vel, drift):
+    pos[k, 0], pos[k, 1], pos[k, 2] = x, y, z
+    clk[k] = clock
+    if want_vel:
+        vel[k, 0], vel[k, 1], vel[k, 2] = vx, vy, vz
+        drift[k] = rate
+
+
+@numba.njit(cache=True, inline="always")
+def _store_nan(k, want_vel, pos, clk, vel, drift):
+    _store(k, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, want_vel, pos, clk, vel, drift)
 
 
 def propagate(params: np.ndarray, idx: np.ndarray, t: np.ndarray, velocity: bool = False):
     """Evaluate records ``params[idx]`` at times ``t`` (GPS seconds since the reference week), both (N,).
 
     Returns ``pos`` (N, 3) m ECEF, ``clk`` (N,) s, and when ``velocity`` also ``vel`` (N, 3) m/s ECEF and
-    ``drift`` (N,) s/s. Entries with ``idx < 0`` are NaN.
+    ``drift`` (N,) s/s. Entries with ``idx < 0`` are NaN, and so are those where Kepler's equation did not
+    converge within ``KEPLER_MAX_ITERATIONS`` Newton steps (only near-parabolic eccentricities; never for
+    GNSS orbits).
     """
     idx = np.ascontiguousarray(idx, dtype=np.int64)
     t = np.ascontiguousarray(t, dtype=float)

@@ -12,9 +12,25 @@ import numpy as np
 
 from .. import gpstime
 from . import kepler
+from .errors import ConstellationInputError, NoStateError
 from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M
 
 SECONDS_PER_WEEK = gpstime.SECONDS_PER_WEEK
+
+
+def _integer_weeks(gps_week) -> np.ndarray:
+    """``gps_week`` as int64, or ConstellationInputError when an element is not a whole, finite number."""
+    week = np.asarray(gps_week)
+    if week.dtype.kind in "iu":
+        return week.astype(np.int64)
+    if week.dtype.kind != "f":
+        raise ConstellationInputError("gps_week", f"found {gps_week!r}; expected an integer GPS week")
+    as_float = week.astype(float)
+    bad = ~np.isfinite(as_float) | (as_float != np.round(as_float))
+    if bad.any():
+        raise ConstellationInputError("gps_week", f"found {as_float[bad].ravel()[0]!r}; expected an integer GPS "
+                                      "week (fractions of a week go in gps_sow)")
+    return as_float.astype(np.int64)
 
 
 @dataclass
@@ -73,9 +89,57 @@ class Constellation:
 
     def _seconds(self, gps_week, gps_sow):
         """Broadcast (week, sow) -> (shape, float seconds since ``ref_week`` flattened)."""
-        week, sow = np.broadcast_arrays(np.asarray(gps_week), np.asarray(gps_sow, dtype=float))
-        t = (week.astype(np.int64) - self.ref_week) * SECONDS_PER_WEEK + sow
+        week, sow = np.broadcast_arrays(_integer_weeks(gps_week), np.asarray(gps_sow, dtype=float))
+        t = (week - self.ref_week) * SECONDS_PER_WEEK + sow
         return week.shape, t.ravel()
+
+    def _intervals(self):
+        """Where states exist: (lo, hi) arrays of seconds since ``ref_week`` (one interval per record; +-inf when
+        always valid) and the period with which they repeat (np.inf: they do not)."""
+        raise NotImplementedError
+
+    def covered(self, gps_week, gps_sow) -> np.ndarray:
+        """Boolean array (shape of the broadcast times): at least one satellite has a state at that GPS time."""
+        shape, t = self._seconds(gps_week, gps_sow)
+        lo, hi, period = self._intervals()
+        if lo.size == 0:
+            return np.zeros(shape, bool)
+        if np.isfinite(period):
+            t = t - period * np.round((t - 0.5 * (lo.min() + hi.max())) / period)
+        order = np.argsort(lo, kind="stable")
+        lo, reach = lo[order], np.maximum.accumulate(hi[order])  # reach: furthest end of intervals begun so far
+        j = np.searchsorted(lo, t, side="right") - 1
+        return ((j >= 0) & (t <= reach[np.maximum(j, 0)])).reshape(shape)
+
+    def validity_span(self, gps_week=None, gps_sow=0.0):
+        """First and last GPS epoch with a state, ((week, sow), (week, sow)); None when states exist at every
+        epoch (nominal constellations). For repeating almanac records (1024-week copies), the copy nearest to
+        (gps_week, gps_sow) (default: the records' own). Gaps inside the span are possible."""
+        lo, hi, period = self._intervals()
+        if lo.size == 0:
+            raise NoStateError(self.source, "no healthy record: no satellite ever has a state")
+        first, last = lo.min(), hi.max()
+        if not (np.isfinite(first) and np.isfinite(last)):
+            return None
+        if gps_week is not None and np.isfinite(period):
+            t = self._seconds(gps_week, gps_sow)[1][0]
+            shift = period * np.round((t - 0.5 * (first + last)) / period)
+            first, last = first + shift, last + shift
+        return gpstime.normalize(self.ref_week, first), gpstime.normalize(self.ref_week, last)
+
+    def require_states(self, gps_week, gps_sow) -> np.ndarray:
+        """:meth:`covered` for the given times, raising :class:`NoStateError` (naming the source, the times and
+        the span the source covers) when no satellite has a state at any of them."""
+        ok = self.covered(gps_week, gps_sow)
+        if ok.any():
+            return ok
+        shape, t = self._seconds(gps_week, gps_sow)
+        asked = [gpstime.normalize(self.ref_week, x) for x in (np.nanmin(t), np.nanmax(t))] if t.size else []
+        span = self.validity_span(*asked[0]) if asked else self.validity_span()
+        when = f"at {_utc(asked[0])}" if asked and asked[0] == asked[1] else \
+            f"from {_utc(asked[0])} to {_utc(asked[1])}" if asked else "at no time given"
+        raise NoStateError(self.source, f"no satellite has a state {when}; the source covers "
+                           f"{describe_span(span)}", span)
 
     def state(self, gps_week, gps_sow, velocity: bool = False):
         """Satellite states at GPS times (transmit time), ECEF of that instant.
@@ -95,7 +159,8 @@ class Constellation:
         shape, t = self._seconds(gps_week, gps_sow)
         s = len(self.sat_ids)
         if not shape or shape[-1] != s:
-            raise ValueError(f"state_each needs times of shape (..., {s}), got {shape}")
+            raise ConstellationInputError("gps_sow", f"state_each needs times of shape (..., {s}) (one column per "
+                                          f"satellite), found {shape}")
         return self._shaped(self._evaluate(t.reshape(-1, s), velocity), shape[:-1])
 
     def _shaped(self, out, shape):
@@ -130,6 +195,16 @@ class Constellation:
             vals[d.sat[order][first]] = d.value[order][first]
             out[name] = vals
         return out
+
+
+def _utc(week_sow) -> str:
+    return gpstime.gps_to_utc(*week_sow).strftime("%Y-%m-%d %H:%M:%S UTC")
+
+
+def describe_span(span) -> str:
+    """'2026-04-26 22:00:00 UTC to 2026-04-28 01:59:44 UTC' for a :meth:`Constellation.validity_span` result
+    (None: 'every epoch')."""
+    return "every epoch" if span is None else f"{_utc(span[0])} to {_utc(span[1])}"
 
 
 @dataclass
@@ -191,6 +266,13 @@ class KeplerConstellation(Constellation):
             ok = np.abs(ts - toe[pick]) <= half[pick]
             idx[:, s] = np.where(ok, rows[pick], -1)
         return idx, t_eval
+
+    def _intervals(self):
+        r = self.records
+        toe = r.params[r.healthy, kepler.COL["toe"]]
+        half = r.half_width[r.healthy]
+        period = np.unique(r.period[r.healthy]) if r.period is not None else np.array([np.inf])
+        return toe - half, toe + half, float(period.min()) if period.size else np.inf
 
     def _evaluate(self, t, velocity):
         idx, t_eval = self.select(t)

@@ -42,7 +42,7 @@ GPS_SLOTS = {
     "E1": (152.847, 197.046), "E2": (152.847, 302.596), "E3": (152.847, 66.066), "E4": (152.847, 333.686),
     "F1": (212.847, 238.886), "F2": (212.847, 345.226), "F3": (212.847, 105.206), "F4": (212.847, 135.346),
 }
-GPS_EPOCH_UTC = datetime(1993, 7, 1, tzinfo=timezone.utc)
+SPS_TABLE_EPOCH_UTC = datetime(1993, 7, 1, tzinfo=timezone.utc)
 GPS_GHA_DEG = (18.0 + 36.0 / 60.0 + 14.4 / 3600.0) * 15.0
 GPS_A = 26559.7e3
 GPS_INC = 55.0 * DEG
@@ -82,9 +82,9 @@ def _records(rows, system, ref_sow):
 
 
 def _gps():
-    week, sow = gpstime.utc_to_gps(GPS_EPOCH_UTC)
+    week, sow = gpstime.utc_to_gps(SPS_TABLE_EPOCH_UTC)
     rate = _j2_node_rate(GPS_A, GPS_INC, GPS.mu)
-    n = 0.5 * (GPS.omega_e - rate)
+    n = 2.0 * (GPS.omega_e - rate)  # 2 revolutions per day relative to the precessing node
     rows = [(f"G{k + 1:02d}", GPS_A, GPS_INC, (raan - GPS_GHA_DEG) * DEG, u * DEG, n, rate)
             for k, (raan, u) in enumerate(GPS_SLOTS.values())]
     return week, _records(rows, GPS, sow)

@@ -16,6 +16,7 @@ from datetime import date
 
 import numpy as np
 
+from .. import gpstime
 from ..errors import DataFileError
 from . import kepler
 from .model import GroupDelays, KeplerConstellation, Klobuchar, Records
@@ -23,7 +24,7 @@ from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M, SYSTEMS
 from .textfile import lines_of, number, read_bytes
 
 N_FIELDS = 31  # af0 af1 af2 + 7 lines x 4 broadcast-orbit values
-_GPS_DAY0 = date(1980, 1, 6).toordinal()
+SECONDS_PER_WEEK = gpstime.SECONDS_PER_WEEK
 # positions within the 31 values (RINEX 3.04 Tables A6 and A14; RINEX 4.00 LNAV/D1/D2 are identical)
 AF0, AF1, AF2, IODE, CRS, DN, M0, CUC, E, CUS, SQRTA, TOE, CIC, OMEGA0, CIS, I0, CRC, OMEGA, OMEGADOT, IDOT, \
     CODES, WEEK, L2P, ACC, HEALTH, TGD1, TGD2 = range(27)
@@ -49,10 +50,10 @@ def _epoch_seconds(text: str, path, line: int) -> float:
     try:
         y, mo, d, h, mi = (int(v) for v in text[:16].split())
         sec = float(text[16:19])
-        day = date(y, mo, d).toordinal() - _GPS_DAY0
+        day = date(y, mo, d).toordinal() - gpstime.GPS_EPOCH_ORDINAL
     except ValueError:
         raise DataFileError(path, f"bad epoch {text.strip()!r}: expected 'YYYY MM DD hh mm ss'", line) from None
-    return day * 86400.0 + h * 3600.0 + mi * 60.0 + sec
+    return day * gpstime.SECONDS_PER_DAY + h * 3600.0 + mi * 60.0 + sec
 
 
 def _values(block: list[str], path, first_line: int) -> np.ndarray:
@@ -248,10 +249,10 @@ def build(ids, vals, source, klob, cnav_delays, path) -> KeplerConstellation:
     offs = np.where(is_bds, SYSTEMS["C"].time_offset_s, 0.0)
     week_off = np.where(is_bds, SYSTEMS["C"].week_offset, 0)
     toc_abs = vals[:, N_FIELDS] + offs
-    toe_abs = (vals[:, WEEK] + week_off) * 604800.0 + vals[:, TOE] + offs
-    toe_abs += 604800.0 * np.round((toc_abs - toe_abs) / 604800.0)
-    ref_week = int(np.floor(toe_abs.min() / 604800.0))
-    t0 = ref_week * 604800.0
+    toe_abs = (vals[:, WEEK] + week_off) * SECONDS_PER_WEEK + vals[:, TOE] + offs
+    toe_abs += SECONDS_PER_WEEK * np.round((toc_abs - toe_abs) / SECONDS_PER_WEEK)
+    ref_week = int(np.floor(toe_abs.min() / SECONDS_PER_WEEK))
+    t0 = ref_week * SECONDS_PER_WEEK
     n = len(ids)
     p = kepler.empty_table(n)
     c = kepler.COL

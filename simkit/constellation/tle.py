@@ -15,7 +15,10 @@ from ..errors import DataFileError
 from .model import Constellation, orbit_types
 
 DEFAULT_VALIDITY_DAYS = 7.0
-_GPS_JD_TAI = 2444244.5  # 1980-01-06 00:00 as a Julian date; GPS = TAI - 19 s
+DAY = gpstime.SECONDS_PER_DAY
+WEEK = gpstime.SECONDS_PER_WEEK
+# GPS time = TAI - 19 s: a GPS-time Julian date is the TAI Julian date minus 19 s; both count from GPS_EPOCH_JD
+TAI_MINUS_GPS = -gpstime.GPS_MINUS_TAI
 _PRN = re.compile(r"\(PRN\s*(\d+)\)")
 _BDS = re.compile(r"\(C\s*(\d+)\)")
 
@@ -52,12 +55,15 @@ class TleConstellation(Constellation):
         ts = gpstime.timescale()
         self._sats = [EarthSatellite(l1, l2, name, ts) for _, name, l1, l2, _ in sats]
         epoch_tai = np.array([s.epoch.tai for s in self._sats])
-        ref_week = int(np.floor((epoch_tai.min() - _GPS_JD_TAI) * 86400.0 / 604800.0))
-        self._epoch = ((epoch_tai - _GPS_JD_TAI) * 86400.0 - 19.0) - ref_week * 604800.0
-        self._half = validity_days * 86400.0
+        ref_week = int(np.floor((epoch_tai.min() - gpstime.GPS_EPOCH_JD) * DAY / WEEK))
+        self._epoch = ((epoch_tai - gpstime.GPS_EPOCH_JD) * DAY - TAI_MINUS_GPS) - ref_week * WEEK
+        self._half = validity_days * DAY
         sqrt_a = [(398600.4418 / (s.model.no_kozai / 60.0) ** 2) ** (1 / 6) * 1e3 ** 0.5 for s in self._sats]
         otype = orbit_types(np.array(sqrt_a), np.array([s.model.inclo for s in self._sats]))
         super().__init__([s[0] for s in sats], otype, source, ref_week)
+
+    def _intervals(self):
+        return self._epoch - self._half, self._epoch + self._half, np.inf
 
     def _evaluate(self, t, velocity):
         from skyfield.framelib import itrs
@@ -71,8 +77,9 @@ class TleConstellation(Constellation):
             if not ok.any():
                 continue
             tt = t[ok, k]
-            whole = _GPS_JD_TAI + self.ref_week * 7.0 + np.floor(tt / 86400.0)
-            frac = (tt - np.floor(tt / 86400.0) * 86400.0 + 19.0) / 86400.0
+            days = np.floor(tt / DAY)
+            whole = gpstime.GPS_EPOCH_JD + self.ref_week * (WEEK / DAY) + days
+            frac = (tt - days * DAY + TAI_MINUS_GPS) / DAY
             r, v = sat.at(ts.tai_jd(whole, frac)).frame_xyz_and_velocity(itrs)
             pos[ok, k] = r.m.T
             vel[ok, k] = v.m_per_s.T
