@@ -232,7 +232,7 @@ def _ils_batch_kernel(A, Qs, m, max_nodes):
 
 # Interpreted up to n = 40 while the kernel compiles: 0.1 ms (n = 3) to ~0.1 s (n = 40, badly conditioned) per
 # solve here, against 4-6 s of compilation (see .warmup).
-_ILS = jit_when_ready(_ils_kernel, max_interpreted_n=40)
+_ILS = jit_when_ready(_ils_kernel, lambda a, *_: a.shape[0], max_interpreted_n=40)
 
 
 class ILSResult:
@@ -301,7 +301,7 @@ def ils(a_hat, Q, n_cands=2, max_nodes=DEFAULT_MAX_NODES) -> ILSResult:
             and a.ndim == 1 and a.size and Qm.shape == (a.size, a.size) and a.flags.c_contiguous
             and Qm.flags.c_contiguous):
         a, Qm = as_problem(a_hat, Q)  # converts, or raises naming the wrong shape
-    code, i, j, cands, costs, nodes, L, d, Z, Zti, zhat, shift = _ILS(a.size, a, Qm, int(n_cands), int(max_nodes))
+    code, i, j, cands, costs, nodes, L, d, Z, Zti, zhat, shift = _ILS.call(a, Qm, int(n_cands), int(max_nodes))
     if code < 0:
         raise_for_status(code, i, j)
     return ILSResult(cands, costs, code == OK, nodes, Z, Zti, L, d, zhat, shift)

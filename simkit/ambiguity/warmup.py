@@ -45,10 +45,16 @@ def _twin_of(value, memo):
 
 
 class JitWhenReady:
-    """Call ``kernel`` compiled once numba has it, its interpreted twin until then (see the module docstring)."""
+    """Call ``kernel`` compiled once numba has it, its interpreted twin until then (see the module docstring).
 
-    def __init__(self, kernel, max_interpreted_n):
-        self.kernel, self.max_interpreted_n = kernel, max_interpreted_n
+    Call through ``.call(*args)``: it is the warming-up function until the compiled kernel is ready, then the
+    numba dispatcher itself, so that a warm call pays nothing for this class. ``size(*args)`` gives the problem
+    size compared with ``max_interpreted_n``.
+    """
+
+    def __init__(self, kernel, size, max_interpreted_n):
+        self.kernel, self.size, self.max_interpreted_n = kernel, size, max_interpreted_n
+        self.call = self._warming_up
         self._twin = None
         self._thread = None
         self._ready = threading.Event()
@@ -58,6 +64,7 @@ class JitWhenReady:
         try:
             self.kernel.compile(sig)
         finally:  # on failure the next call compiles in the caller's thread and raises there
+            self.call = self.kernel
             self._ready.set()
 
     def start(self, *args):
@@ -74,12 +81,11 @@ class JitWhenReady:
         if self._thread is not None:
             self._ready.wait()
 
-    def __call__(self, n, *args):
-        """Run the kernel on ``args``; ``n`` is the problem size that decides whether interpreting is worth it."""
+    def _warming_up(self, *args):
         if self._ready.is_set():
             return self.kernel(*args)
         self.start(*args)
-        if n > self.max_interpreted_n:
+        if self.size(*args) > self.max_interpreted_n:
             self._ready.wait()
             return self.kernel(*args)
         if self._twin is None:
@@ -90,9 +96,9 @@ class JitWhenReady:
 _ALL: list[JitWhenReady] = []
 
 
-def jit_when_ready(kernel, max_interpreted_n) -> JitWhenReady:
+def jit_when_ready(kernel, size, max_interpreted_n) -> JitWhenReady:
     """A :class:`JitWhenReady` for ``kernel``, registered so that a fork waits for its compilation first."""
-    j = JitWhenReady(kernel, max_interpreted_n)
+    j = JitWhenReady(kernel, size, max_interpreted_n)
     _ALL.append(j)
     return j
 
