@@ -2,7 +2,8 @@
 
 Run: python benchmarks/bench_lambda.py. Same random problems (simkit.ambiguity.problems.random_problem, "well"
 conditioned, i.e. GNSS-like after a few epochs) for every solver; RTKLIB is timed on pre-filled buffers; medians
-over problems of the per-problem mean time.
+over problems of the per-problem mean time. The compiled kernel is timed (see simkit/ambiguity/warmup.py; the
+cold start is benchmarks/bench_cold_start.py).
 """
 import os
 import time
@@ -11,6 +12,7 @@ import numpy as np
 
 from simkit.ambiguity import ils
 from simkit.ambiguity.problems import random_problem
+from simkit.ambiguity.warmup import wait_for_jit
 
 
 def _time(fn, reps):
@@ -25,6 +27,8 @@ def main(sizes=(10, 20, 40), n_problems=30):
     from cssrlib.mlambda import mlambda
 
     rtk = getattr(pyrtklib, "lambda")
+    ils(np.zeros(3), np.eye(3))
+    wait_for_jit()  # time the compiled kernel, not the interpreted one that answers while numba compiles
     devnull = os.open(os.devnull, os.O_WRONLY)
     saved = os.dup(2)
     print(f"{'n':>3} {'simkit us':>10} {'RTKLIB C us':>12} {'cssrlib us':>11} {'simkit/C':>9} {'cssrlib/simkit':>15}")

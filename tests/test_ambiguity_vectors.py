@@ -39,6 +39,17 @@ def test_ils_candidates_and_sqnorms(name):
 
 
 @pytest.mark.parametrize("name", CASES)
+def test_ratio_is_defined_for_every_n_cands(name):
+    a, Q, e = _case(name)
+    two = amb.ils(a, Q, n_cands=2)
+    assert two.ratio == pytest.approx(1.0 / e["ratio_sq1_over_sq2"], rel=2 * SQ_RTOL.get(name, 1e-9))
+    one = amb.ils(a, Q, n_cands=1)  # no second candidate: NaN (documented), never an IndexError
+    np.testing.assert_array_equal(one.candidates[0], e["ils_best"])
+    assert np.isnan(one.ratio)
+    assert not one.ratio >= amb.DEFAULT_RATIO_THRESHOLD  # NaN accepts no fix
+
+
+@pytest.mark.parametrize("name", CASES)
 def test_decorrelation_and_bootstrap_success_rate(name):
     a, Q, e = _case(name)
     dec = amb.decorrelate(Q)

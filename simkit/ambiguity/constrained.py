@@ -15,65 +15,152 @@ Ordering for r baselines: ``a_hat = [a_1; ...; a_r]`` (baseline-major), ``b_hat 
 """
 from __future__ import annotations
 
+import math
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-from .decorrelation import OK, as_problem
+from .decorrelation import OK, as_problem, new_decorrelated, prepare
 from .errors import AmbiguityInputError
-from .search import DEFAULT_MAX_NODES, MODE_ATTITUDE, MODE_LENGTH, back_transform, prepare_new, search_into
+from .inner import rotation_fit, sphere_fit
+from .search import DEFAULT_MAX_NODES, Best, back_transform, make_search
 
 
-@njit(cache=True)
-def _solve_one(a, Qa, bhat, Qb, Qba, mode, F, lengths, m, max_nodes, cands, costs, sols):
-    n = a.shape[0]
-    code, i, j, shift, L, d, Z, Zti, zhat = prepare_new(a, Qa)
-    if code != OK:
-        return code, i, j, 0
-    K = np.linalg.solve(Qa, Qba.T).T  # Qba Qa^-1, (p, n)
-    P = K @ Zti.astype(np.float64)
-    Qbz = Qb - K @ Qba.T
+class Epoch(NamedTuple):
+    """One epoch's float solution (or K stacked along a leading axis), as the kernels take it."""
+
+    a_hat: np.ndarray  # (n,) cycles
+    Qa: np.ndarray  # (n, n) cycles^2
+    b_hat: np.ndarray  # (p,) m, p = 3 r
+    Qb: np.ndarray  # (p, p) m^2
+    Qba: np.ndarray  # (p, n) cross-covariance b-a, m cycles
+
+
+class Constraint(NamedTuple):
+    """What a constrained leaf needs: the conditioned float baseline and its weight, plus the constraint."""
+
+    P: np.ndarray  # (p, n) Qba Qa^-1 Z^-T: baseline change per unit of decorrelated ambiguity residual
+    v: np.ndarray  # (p,) b_hat, m
+    W: np.ndarray  # (p, p) weight of the conditioned baseline Qb(z)^-1, 1/m^2
+    U: np.ndarray  # (p, p) eigenvectors of W
+    w: np.ndarray  # (p,) eigenvalues of W, ascending
+    F: np.ndarray  # (3, r) body-frame baselines, m (attitude only)
+    lengths: np.ndarray  # (r,) baseline lengths, m
+
+
+@njit
+def _conditioned(ctx, w, z, budget, dist):
+    """``b_hat(z)`` for the leaf ``z`` (p,), or an empty array when the cheap bound already exceeds ``budget``.
+
+    The bound: on the constraint ``|x_j| = l_j``, so ``|c_j - x_j| >= | |c_j| - l_j |`` and the inner minimum is at
+    least ``w_min sum_j (|c_j| - l_j)^2``.
+    """
+    c = ctx.v.copy()
+    for k in range(c.shape[0]):
+        s = 0.0
+        for i in range(z.shape[0]):
+            s += ctx.P[k, i] * (w.zhat[i] - z[i])
+        c[k] -= s
+    lb = 0.0
+    for j in range(ctx.lengths.shape[0]):
+        nj = math.sqrt(c[3 * j] ** 2 + c[3 * j + 1] ** 2 + c[3 * j + 2] ** 2)
+        lb += (nj - ctx.lengths[j]) ** 2
+    return c[:0] if dist + ctx.w[0] * lb >= budget else c
+
+
+@njit
+def length_leaf(ctx, dist, w, z, budget, out):
+    """C-LAMBDA leaf cost: squared norm plus the exact minimum on the sphere ``|b| = l`` (baseline into ``out``)."""
+    c = _conditioned(ctx, w, z, budget, dist)
+    if c.shape[0] == 0:
+        return math.inf
+    return dist + sphere_fit(c, ctx.U, ctx.w, ctx.lengths[0], out)
+
+
+@njit
+def attitude_leaf(ctx, dist, w, z, budget, out):
+    """Multivariate constrained leaf cost: squared norm plus the minimum over SO(3) (R row-major into ``out``)."""
+    c = _conditioned(ctx, w, z, budget, dist)
+    if c.shape[0] == 0:
+        return math.inf
+    return dist + rotation_fit(c, ctx.W, ctx.F, out)
+
+
+@njit
+def _constraint(ep, w, F, lengths):
+    """The :class:`Constraint` of epoch ``ep`` decorrelated into ``w``; ok = False when Qb(z) is not PD."""
+    K = np.linalg.solve(ep.Qa, ep.Qba.T).T  # Qba Qa^-1, (p, n)
+    Qbz = ep.Qb - K @ ep.Qba.T
     W = np.linalg.inv(0.5 * (Qbz + Qbz.T))
     W = 0.5 * (W + W.T)
-    w, U = np.linalg.eigh(W)
-    if not w[0] > 0.0:
-        return -3, -1, -1, 0
-    cz = np.zeros((m, n))
-    # search-and-expand: a first leaf far off the constraint would make search-and-shrink start from a huge
-    # ellipsoid, so search below chi2 and expand it until m candidates are inside (then they are the m best)
-    chi2 = float(n + bhat.shape[0])
-    total = 0
-    while True:
-        status, nodes, found = search_into(zhat, L, d, max_nodes - total, mode, P, bhat, W, U, w, F, lengths, cz,
-                                           costs, sols, chi2)
-        total += nodes
-        if found == m or status != OK or total >= max_nodes:
-            break
-        chi2 *= 4.0
-    cands[:, :] = back_transform(cz, Zti, shift)
-    return status, 0, 0, total
+    ev, U = np.linalg.eigh(W)
+    return ev[0] > 0.0, Constraint(K @ w.Zti.astype(np.float64), ep.b_hat, W, U, ev, F, lengths)
+
+
+def _batch_solver(leaf_cost):
+    """The constrained batch solver for one leaf cost (:func:`length_leaf` or :func:`attitude_leaf`)."""
+    search = make_search(leaf_cost)
+
+    @njit
+    def solve_epoch(ep, F, lengths, max_nodes, best, cands):
+        """Decorrelate, then search-and-expand: a first leaf far off the constraint would make search-and-shrink
+        start from a huge ellipsoid, so search below chi2 and expand it until m candidates are inside (then
+        they are the m best). Writes ``best`` and ``cands`` (m, n) int64; returns (status, i, j, nodes)."""
+        w = new_decorrelated(ep.a_hat.shape[0])
+        code, i, j = prepare(ep.a_hat, ep.Qa, w)
+        if code != OK:
+            return code, i, j, 0
+        ok, ctx = _constraint(ep, w, F, lengths)
+        if not ok:
+            return -3, -1, -1, 0
+        chi2 = float(ep.a_hat.shape[0] + ep.b_hat.shape[0])
+        total = 0
+        while True:
+            status, nodes, found = search(ctx, w, best, max_nodes - total, chi2)
+            total += nodes
+            if found == best.costs.shape[0] or status != OK or total >= max_nodes:
+                break
+            chi2 *= 4.0
+        cands[:, :] = back_transform(best.cands, w.Zti, w.shift)
+        return status, 0, 0, total
+
+    @njit
+    def solve_batch(eps, F, lengths, m, max_nodes, k_out):
+        """Every epoch of the stacked ``eps``, ``lengths`` (K, r): (cands, costs, sols, status, nodes, err)."""
+        K, n = eps.a_hat.shape
+        cands = np.zeros((K, m, n), dtype=np.int64)
+        costs = np.full((K, m), np.inf)
+        sols = np.full((K, m, k_out), np.nan)
+        status = np.zeros(K, dtype=np.int64)
+        nodes = np.zeros(K, dtype=np.int64)
+        err = np.full(3, -1, dtype=np.int64)
+        cz = np.zeros((m, n))
+        for k in range(K):
+            ep = Epoch(eps.a_hat[k], eps.Qa[k], eps.b_hat[k], eps.Qb[k], eps.Qba[k])
+            best = Best(cz, costs[k], sols[k])
+            code, i, j, nodes[k] = solve_epoch(ep, F, lengths[k], max_nodes, best, cands[k])
+            status[k] = code
+            if code < 0 and err[0] < 0:
+                err[0], err[1], err[2] = k, i, j
+        return cands, costs, sols, status, nodes, err
+
+    return solve_batch
+
+
+_solve_length = _batch_solver(length_leaf)
+_solve_attitude = _batch_solver(attitude_leaf)
+
+
+# One cached entry kernel per constraint, so that each compiles (and loads) only its own inner problem.
+@njit(cache=True)
+def _length_batch(eps, F, lengths, m, max_nodes):
+    return _solve_length(eps, F, lengths, m, max_nodes, 3)
 
 
 @njit(cache=True)
-def _solve_batch(A, Qa, Bh, Qb, Qba, mode, F, lengths, m, max_nodes):
-    K, n = A.shape
-    k_out = 3 if mode == MODE_LENGTH else 9
-    cands = np.zeros((K, m, n), dtype=np.int64)
-    costs = np.full((K, m), np.inf)
-    sols = np.full((K, m, k_out), np.nan)
-    status = np.zeros(K, dtype=np.int64)
-    nodes = np.zeros(K, dtype=np.int64)
-    err = np.full(3, -1, dtype=np.int64)
-    for k in range(K):
-        if mode == MODE_LENGTH:
-            ln = lengths[k:k + 1] if lengths.shape[0] == K else lengths[0:1]
-        else:
-            ln = lengths
-        code, i, j, nodes[k] = _solve_one(A[k], Qa[k], Bh[k], Qb[k], Qba[k], mode, F, ln, m, max_nodes,
-                                          cands[k], costs[k], sols[k])
-        status[k] = code
-        if code < 0 and err[0] < 0:
-            err[0], err[1], err[2] = k, i, j
-    return cands, costs, sols, status, nodes, err
+def _attitude_batch(eps, F, lengths, m, max_nodes):
+    return _solve_attitude(eps, F, lengths, m, max_nodes, 9)
 
 
 class ConstrainedResult:
@@ -101,36 +188,35 @@ def _stack(x, ndim, what, K=None):
     return arr
 
 
-def _run(a_hat, Qa, b_hat, Qb, Qba, mode, F, lengths, n_cands, max_nodes):
+def _epochs(a_hat, Qa, b_hat, Qb, Qba) -> Epoch:
+    """The inputs stacked over K epochs (a single epoch gets K = 1), shapes checked."""
     A = _stack(a_hat, 2, "a_hat")
-    single = np.ndim(a_hat) == 1
     K, n = A.shape
-    Qa_ = _stack(Qa, 3, "Qa", K)
-    Bh = _stack(b_hat, 2, "b_hat", K)
-    p = Bh.shape[1]
-    Qb_ = _stack(Qb, 3, "Qb", K)
-    Qba_ = _stack(Qba, 3, "Qba", K)
-    if Qa_.shape[1:] != (n, n):
-        raise AmbiguityInputError("Qa", f"shape {Qa_.shape[1:]} per epoch; expected ({n}, {n})")
-    if Qb_.shape[1:] != (p, p):
-        raise AmbiguityInputError("Qb", f"shape {Qb_.shape[1:]} per epoch; expected ({p}, {p})")
-    if Qba_.shape[1:] != (p, n):
-        raise AmbiguityInputError("Qba", f"shape {Qba_.shape[1:]} per epoch; expected ({p}, {n})")
+    ep = Epoch(A, _stack(Qa, 3, "Qa", K), _stack(b_hat, 2, "b_hat", K), _stack(Qb, 3, "Qb", K),
+               _stack(Qba, 3, "Qba", K))
+    p = ep.b_hat.shape[1]
+    for what, want in (("Qa", (n, n)), ("Qb", (p, p)), ("Qba", (p, n))):
+        if getattr(ep, what).shape[1:] != want:
+            raise AmbiguityInputError(what, f"shape {getattr(ep, what).shape[1:]} per epoch; expected {want}")
     for k in range(K):
-        as_problem(A[k], Qa_[k], what=f"[{k}]" if not single else "")
-    if int(n_cands) < 1:
+        as_problem(A[k], ep.Qa[k], what=f"[{k}]" if np.ndim(a_hat) > 1 else "")
+    return ep
+
+
+def _run(kernel, ep, single, F, lengths, n_cands, max_nodes):
+    """Run ``kernel`` (:func:`_length_batch` or :func:`_attitude_batch`) and wrap its output; ``lengths`` (K, r)."""
+    if int(n_cands) != n_cands or n_cands < 1:
         raise AmbiguityInputError("n_cands", f"{n_cands!r}; expected an integer >= 1")
-    cands, costs, sols, status, nodes, err = _solve_batch(A, Qa_, Bh, Qb_, Qba_, mode, F, lengths, int(n_cands),
-                                                          int(max_nodes))
+    cands, costs, sols, status, nodes, err = kernel(ep, F, lengths, int(n_cands), int(max_nodes))
     if err[0] >= 0:
         if err[1] < 0:
             raise AmbiguityInputError(f"Qb[{err[0]}]", "conditional baseline covariance is not positive definite")
         raise AmbiguityInputError(f"Qa[{int(err[0])}]", "not symmetric positive definite (or a_hat not finite)")
     finished = status == OK
-    if mode == MODE_LENGTH:
+    if kernel is _length_batch:
         res = ConstrainedResult(cands, costs, finished, nodes, sols)
     else:
-        R = sols.reshape(K, -1, 3, 3)
+        R = sols.reshape(len(cands), -1, 3, 3)
         res = ConstrainedResult(cands, costs, finished, nodes, R @ F, R)
     if single:
         res = ConstrainedResult(res.candidates[0], res.costs[0], bool(res.finished[0]), int(res.nodes[0]),
@@ -149,7 +235,12 @@ def baseline_constrained_ils(a_hat, Qa, b_hat, Qb, Qba, length, n_cands=2, max_n
         raise AmbiguityInputError("b_hat", f"shape {np.shape(b_hat)}; expected (3,) per epoch")
     if not np.all(lengths > 0):
         raise AmbiguityInputError("length", f"{length!r}; expected a positive baseline length in metres")
-    return _run(a_hat, Qa, b_hat, Qb, Qba, MODE_LENGTH, np.zeros((3, 1)), lengths, n_cands, max_nodes)
+    ep = _epochs(a_hat, Qa, b_hat, Qb, Qba)
+    K = ep.a_hat.shape[0]
+    if lengths.shape not in ((1,), (K,)):
+        raise AmbiguityInputError("length", f"shape {lengths.shape}; expected a scalar or ({K},), one per epoch")
+    lengths = np.ascontiguousarray(np.broadcast_to(lengths[:, None], (K, 1)))
+    return _run(_length_batch, ep, np.ndim(a_hat) == 1, np.zeros((3, 1)), lengths, n_cands, max_nodes)
 
 
 def attitude_constrained_ils(a_hat, Qa, b_hat, Qb, Qba, body_baselines, n_cands=2, max_nodes=DEFAULT_MAX_NODES):
@@ -162,4 +253,6 @@ def attitude_constrained_ils(a_hat, Qa, b_hat, Qb, Qba, body_baselines, n_cands=
     F = np.ascontiguousarray(body_baselines, dtype=np.float64)
     if F.ndim != 2 or F.shape[0] != 3 or np.shape(b_hat)[-1] != 3 * F.shape[1]:
         raise AmbiguityInputError("body_baselines", f"shape {F.shape}; expected (3, r) with b_hat of 3 r values")
-    return _run(a_hat, Qa, b_hat, Qb, Qba, MODE_ATTITUDE, F, np.linalg.norm(F, axis=0), n_cands, max_nodes)
+    ep = _epochs(a_hat, Qa, b_hat, Qb, Qba)
+    lengths = np.ascontiguousarray(np.broadcast_to(np.linalg.norm(F, axis=0), (ep.a_hat.shape[0], F.shape[1])))
+    return _run(_attitude_batch, ep, np.ndim(a_hat) == 1, F, lengths, n_cands, max_nodes)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -158,15 +159,64 @@ def as_problem(a_hat, Q, what: str = ""):
     return a, Qm
 
 
-def _checked_ltdl(Q):
+class Decorrelated(NamedTuple):
+    """Work arrays of one decorrelated problem, filled by :func:`prepare` (a numba-compatible named tuple).
+
+    ``Q = Z^-T L^T diag(d) L Z^-1``; ``zhat = Z^T (a - shift)`` with the integer ``shift = round(a)``.
+    """
+
+    L: np.ndarray  # (n, n) unit lower-triangular factor of Qz
+    d: np.ndarray  # (n,) conditional variances of z, cycles^2
+    Z: np.ndarray  # (n, n) int64 unimodular
+    Zti: np.ndarray  # (n, n) int64, Z^-T
+    zhat: np.ndarray  # (n,) decorrelated float ambiguities (integer part taken out)
+    shift: np.ndarray  # (n,) int64
+
+
+@njit(cache=True)
+def new_decorrelated(n):
+    """Uninitialised :class:`Decorrelated` work arrays for a problem of size ``n``."""
+    return Decorrelated(np.empty((n, n)), np.empty(n), np.empty((n, n), dtype=np.int64),
+                        np.empty((n, n), dtype=np.int64), np.empty(n), np.empty(n, dtype=np.int64))
+
+
+@njit(cache=True)
+def prepare(a, Q, w):
+    """Check, factorise and decorrelate ``(a, Q)`` into ``w`` (:class:`Decorrelated`). Returns (code, i, j).
+
+    The one place where ``a`` and ``Q`` are checked, factorised and reduced: :func:`decorrelate` and every
+    search kernel call it.
+    """
+    n = a.shape[0]
+    for r in range(n):
+        if not math.isfinite(a[r]):
+            return ERR_NONFINITE, -1, r
     code, i, j = check_matrix(Q)
-    raise_for_status(code, i, j)
-    n = Q.shape[0]
-    L, d = np.empty((n, n)), np.empty(n)
-    bad = ltdl_into(Q, L, d)
+    if code != OK:
+        return code, i, j
+    bad = ltdl_into(Q, w.L, w.d)
     if bad >= 0:
-        raise_for_status(ERR_NOT_PD, bad, 0)
-    return L, d
+        return ERR_NOT_PD, bad, 0
+    for r in range(n):
+        for c in range(n):
+            w.Z[r, c] = 1 if r == c else 0
+            w.Zti[r, c] = 1 if r == c else 0
+    reduce_into(w.L, w.d, w.Z, w.Zti)
+    for r in range(n):
+        w.shift[r] = np.int64(math.floor(a[r] + 0.5))
+    for c in range(n):
+        s = 0.0
+        for r in range(n):
+            s += w.Z[r, c] * (a[r] - w.shift[r])
+        w.zhat[c] = s
+    return OK, 0, 0
+
+
+def _as_square(Q):
+    Qm = np.ascontiguousarray(Q, dtype=np.float64)
+    if Qm.ndim != 2 or Qm.shape[0] != Qm.shape[1] or Qm.shape[0] == 0:
+        raise AmbiguityInputError("Q", f"shape {Qm.shape}; expected a square (n, n) matrix")
+    return Qm
 
 
 def ltdl(Q):
@@ -174,10 +224,15 @@ def ltdl(Q):
 
     Returns ``(L, d)``: ``L`` unit lower-triangular (n, n), ``d`` (n,) conditional variances (cycles^2).
     """
-    Qm = np.ascontiguousarray(Q, dtype=np.float64)
-    if Qm.ndim != 2 or Qm.shape[0] != Qm.shape[1] or Qm.shape[0] == 0:
-        raise AmbiguityInputError("Q", f"shape {Qm.shape}; expected a square (n, n) matrix")
-    return _checked_ltdl(Qm)
+    Qm = _as_square(Q)
+    code, i, j = check_matrix(Qm)
+    raise_for_status(code, i, j)
+    n = Qm.shape[0]
+    L, d = np.empty((n, n)), np.empty(n)
+    bad = ltdl_into(Qm, L, d)
+    if bad >= 0:
+        raise_for_status(ERR_NOT_PD, bad, 0)
+    return L, d
 
 
 @dataclass(frozen=True)
@@ -197,13 +252,12 @@ def decorrelate(Q, a_hat=None) -> Decorrelation:
     if a_hat is not None:
         a, Qm = as_problem(a_hat, Q)
     else:
-        Qm = np.ascontiguousarray(Q, dtype=np.float64)
-        if Qm.ndim != 2 or Qm.shape[0] != Qm.shape[1] or Qm.shape[0] == 0:
-            raise AmbiguityInputError("Q", f"shape {Qm.shape}; expected a square (n, n) matrix")
-        a = None
-    L, d = _checked_ltdl(Qm)
-    n = d.size
-    Z, Zti = np.eye(n, dtype=np.int64), np.eye(n, dtype=np.int64)
-    reduce_into(L, d, Z, Zti)
-    Qz = L.T @ (d[:, None] * L)
-    return Decorrelation(Z, Zti, Qz, L, d, None if a is None else Z.T.astype(np.float64) @ a)
+        Qm = _as_square(Q)
+        a = np.zeros(Qm.shape[0])
+    n = a.size
+    w = Decorrelated(np.empty((n, n)), np.empty(n), np.empty((n, n), dtype=np.int64),
+                     np.empty((n, n), dtype=np.int64), np.empty(n), np.empty(n, dtype=np.int64))
+    code, i, j = prepare(a, Qm, w)
+    raise_for_status(code, i, j)
+    Qz = w.L.T @ (w.d[:, None] * w.L)
+    return Decorrelation(w.Z, w.Zti, Qz, w.L, w.d, None if a_hat is None else w.Z.T.astype(np.float64) @ a)

@@ -6,19 +6,25 @@ import numpy as np
 from .decorrelation import as_problem, decorrelate, ltdl
 
 
-def _round(x):
+def round_half_up(x):
+    """Nearest integer, halves up (float array): the rounding every estimator here uses."""
     return np.floor(x + 0.5)
 
 
-def _bootstrap_z(zhat, L):
-    """Sequential conditional rounding from index n-1 down to 0 (``Q = L^T diag(d) L``)."""
-    n = zhat.size
-    z = np.empty(n)
-    e = np.zeros(n)  # z_j - zcond_j for the levels already fixed
+def bootstrap_z(zhat, L):
+    """Sequential conditional rounding from index n-1 down to 0 (``Q = L^T diag(d) L``), as floats.
+
+    ``zhat`` (..., n): leading axes are independent problems sharing ``L`` (the Monte Carlo success rate passes
+    all its samples at once).
+    """
+    zhat = np.asarray(zhat, dtype=np.float64)
+    n = zhat.shape[-1]
+    z = np.empty_like(zhat)
+    e = np.zeros_like(zhat)  # z_j - zcond_j for the levels already fixed
     for k in range(n - 1, -1, -1):
-        zc = zhat[k] + L[k + 1:, k] @ e[k + 1:]
-        z[k] = _round(zc)
-        e[k] = z[k] - zc
+        zc = zhat[..., k] + e[..., k + 1:] @ L[k + 1:, k]
+        z[..., k] = round_half_up(zc)
+        e[..., k] = z[..., k] - zc
     return z
 
 
@@ -27,19 +33,19 @@ def rounding(a_hat, Q=None, decorrelate_first=True):
     ``decorrelate_first`` (then rounded z is mapped back with ``a = Z^-T z``)."""
     if Q is None or not decorrelate_first:
         a = np.asarray(a_hat, dtype=np.float64)
-        return _round(a).astype(np.int64)
+        return round_half_up(a).astype(np.int64)
     a, Qm = as_problem(a_hat, Q)
-    shift = _round(a)
+    shift = round_half_up(a)
     dec = decorrelate(Qm, a - shift)
-    return dec.Zti @ _round(dec.z_hat).astype(np.int64) + shift.astype(np.int64)
+    return dec.Zti @ round_half_up(dec.z_hat).astype(np.int64) + shift.astype(np.int64)
 
 
 def bootstrapping(a_hat, Q, decorrelate_first=True):
     """Integer bootstrapping (sequential conditional rounding, from index n-1 down) -> (n,) int64."""
     a, Qm = as_problem(a_hat, Q)
-    shift = _round(a)
+    shift = round_half_up(a)
     if decorrelate_first:
         dec = decorrelate(Qm, a - shift)
-        return dec.Zti @ _bootstrap_z(dec.z_hat, dec.L).astype(np.int64) + shift.astype(np.int64)
+        return dec.Zti @ bootstrap_z(dec.z_hat, dec.L).astype(np.int64) + shift.astype(np.int64)
     L, _ = ltdl(Qm)
-    return _bootstrap_z(a - shift, L).astype(np.int64) + shift.astype(np.int64)
+    return bootstrap_z(a - shift, L).astype(np.int64) + shift.astype(np.int64)

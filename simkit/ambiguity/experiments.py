@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..gnss.differencing import dd_covariance, double_difference, reference_satellites
 from ..rng import generator
 from .constrained import baseline_constrained_ils
 from .search import ils_batch
@@ -35,6 +36,14 @@ class FloatSolution:
     Qba: np.ndarray
 
 
+def _between_satellite_cofactor(n):
+    """D D^T (n, n) of the between-satellite difference of n + 1 satellites: half the DD covariance of one antenna
+    pair with unit undifferenced sigma (simkit.gnss.differencing.dd_covariance), I + 1 1^T."""
+    ref = np.zeros(n + 1, dtype=np.int64)  # satellite 0 is the reference; which one does not change D D^T
+    Q, _, _ = dd_covariance(np.ones((2, n + 1)), ref, np.ones(n + 1, bool))
+    return 0.5 * Q
+
+
 def float_solution(G, carrier_cycles, code_m, wavelength_m, sigma_phase_m, sigma_code_m) -> FloatSolution:
     """Least-squares float solution of single-epoch DD carrier and code for r baselines from one master antenna.
 
@@ -45,7 +54,7 @@ def float_solution(G, carrier_cycles, code_m, wavelength_m, sigma_phase_m, sigma
     """
     T, n, _ = G.shape
     r = carrier_cycles.shape[1]
-    C0 = np.eye(n) + np.ones((n, n))  # D D^T
+    C0 = _between_satellite_cofactor(n)
     Ci = np.linalg.inv(C0)
     wp, wc = 1.0 / sigma_phase_m**2, 1.0 / sigma_code_m**2
     lam = wavelength_m
@@ -76,24 +85,32 @@ def sky_uniform_los(rng, n_sats, trials, mask_deg=10.0):
     return np.stack([cos_el * np.sin(az), cos_el * np.cos(az), sin_el], axis=-1)
 
 
+def _double_differences(x, ref_sat):
+    """DDs of ``x`` (T, A, S) against antenna 0 and the satellites ``ref_sat`` (T, S), reference columns dropped:
+    (T, A-1, S-1), the other satellites in index order."""
+    dd = double_difference(x, ref_sat)
+    keep = np.argsort(ref_sat == np.arange(x.shape[2]), axis=1, kind="stable")[:, :-1]  # (T, S-1)
+    return np.take_along_axis(dd, keep[:, None, :], axis=2)
+
+
 def simulate_epochs(rng, los, baselines_m, wavelength_m, sigma_phase_m, sigma_code_m):
     """DD geometry, observations and true DD ambiguities for baselines (T, 3, r) seen along ``los`` (T, S, 3).
 
-    Returns (G (T, S-1, 3), carrier (T, r, S-1) cycles, code (T, r, S-1) m, a_true (T, r, S-1) int64).
+    The differences are simkit.gnss.differencing's: antenna 0 is the master (at the origin) and each epoch's
+    reference satellite is the highest one. Returns (G (T, S-1, 3), carrier (T, r, S-1) cycles, code (T, r, S-1) m,
+    a_true (T, r, S-1) int64).
     """
     T, S, _ = los.shape
     r = baselines_m.shape[2]
-    ref = np.argmax(los[:, :, 2], axis=1)
-    others = np.array([np.delete(np.arange(S), i) for i in ref])  # (T, S-1)
-    e_ref = los[np.arange(T), ref]
-    e_oth = np.take_along_axis(los, others[:, :, None], axis=1)
-    G = -(e_oth - e_ref[:, None, :])
+    sat_ids = [f"G{s + 1:02d}" for s in range(S)]  # one system: one reference satellite per epoch
+    ref = reference_satellites(np.arcsin(np.clip(los[:, :, 2], -1.0, 1.0)), np.ones((T, S), bool), sat_ids)
+    # DD range = G b with G = -(e_s - e_ref): the DDs of "antennas" whose ranges are -e (one per ENU axis)
+    unit = np.concatenate([np.zeros((T, 1, S)), -np.swapaxes(los, 1, 2)], axis=1)  # (T, 4, S)
+    G = np.swapaxes(_double_differences(unit, ref), 1, 2)  # (T, S-1, 3)
     rho = np.einsum("tsi,tir->trs", G, baselines_m)  # DD ranges (T, r, S-1)
 
-    def dd_noise(sigma):  # undifferenced noise at r + 1 antennas, differenced between antennas and satellites
-        e = sigma * rng.standard_normal((T, r + 1, S))
-        sd = e[:, 1:, :] - e[:, :1, :]
-        return np.take_along_axis(sd, others[:, None, :], axis=2) - sd[np.arange(T), :, ref][:, :, None]
+    def dd_noise(sigma):  # undifferenced noise at the r + 1 antennas
+        return _double_differences(sigma * rng.standard_normal((T, r + 1, S)), ref)
 
     a_true = rng.integers(-50, 51, (T, r, S - 1))
     carrier = rho / wavelength_m + a_true + dd_noise(sigma_phase_m) / wavelength_m

@@ -28,6 +28,52 @@ def _secular_norm(g, w, lam):
 
 
 @njit(cache=True)
+def _hard_case(g, w, cp, length, bp):
+    """The hard case of the trust-region-like problem (``g`` has no component along the weakest axis and the
+    rest of the solution lies inside the sphere): fill ``bp`` and return True, else return False."""
+    p = g.shape[0]
+    rest = 0.0
+    for i in range(1, p):
+        if w[i] > w[0]:
+            t = g[i] / (w[i] - w[0])
+            rest += t * t
+    if rest > length * length:
+        return False
+    for i in range(1, p):
+        bp[i] = g[i] / (w[i] - w[0]) if w[i] > w[0] else 0.0
+    bp[0] = math.copysign(math.sqrt(length * length - rest), cp[0])
+    return True
+
+
+@njit(cache=True)
+def _secular_root(g, w, length, lo, hi):
+    """The multiplier ``lam`` in (lo, hi) with ``|b(lam)| = length``: Newton on 1/h(lam) - 1/length (nearly
+    linear in lam), safeguarded by bisection."""
+    p = g.shape[0]
+    lam = hi
+    for _ in range(100):
+        h = _secular_norm(g, w, lam)
+        if abs(h - length) <= 1e-15 * length:
+            break
+        if h > length:
+            lo = lam
+        else:
+            hi = lam
+        s3 = 0.0
+        for i in range(p):
+            t = w[i] + lam
+            s3 += g[i] * g[i] / (t * t * t)
+        step = (1.0 / h - 1.0 / length) * h * h * h / s3
+        nxt = lam - step
+        if not (lo < nxt < hi):
+            nxt = 0.5 * (lo + hi)
+        if nxt == lam or hi - lo <= 1e-15 * (abs(lo) + abs(hi)):
+            break
+        lam = nxt
+    return lam
+
+
+@njit(cache=True)
 def sphere_fit(c, U, w, length, out):
     """Minimise ``(c - b)^T W (c - b)`` subject to ``|b| = length``; ``W = U diag(w) U^T``, ``w`` ascending > 0.
 
@@ -43,45 +89,12 @@ def sphere_fit(c, U, w, length, out):
     bp = np.zeros(p)
     if gn == 0.0:  # c = 0: every point of the sphere is at the same W-distance along the weakest axis
         bp[0] = length
-        lam = -w[0]
     else:
         lo = max(-w[0], gn / length - w[p - 1])
         hi = gn / length - w[0]
-        hard = False
-        if lo == -w[0] and abs(g[0]) <= 1e-13 * gn:
-            rest = 0.0
-            for i in range(1, p):
-                if w[i] > w[0]:
-                    t = g[i] / (w[i] - w[0])
-                    rest += t * t
-            if rest <= length * length:
-                hard = True
-                lam = -w[0]
-                for i in range(1, p):
-                    bp[i] = g[i] / (w[i] - w[0]) if w[i] > w[0] else 0.0
-                bp[0] = math.copysign(math.sqrt(length * length - rest), cp[0])
+        hard = lo == -w[0] and abs(g[0]) <= 1e-13 * gn and _hard_case(g, w, cp, length, bp)
         if not hard:
-            lam = hi
-            for _ in range(100):
-                h = _secular_norm(g, w, lam)
-                if abs(h - length) <= 1e-15 * length:
-                    break
-                if h > length:
-                    lo = lam
-                else:
-                    hi = lam
-                s3 = 0.0
-                for i in range(p):
-                    t = w[i] + lam
-                    s3 += g[i] * g[i] / (t * t * t)
-                # Newton on 1/h(lam) - 1/length, nearly linear in lam
-                step = (1.0 / h - 1.0 / length) * h * h * h / s3
-                nxt = lam - step
-                if not (lo < nxt < hi):
-                    nxt = 0.5 * (lo + hi)
-                if nxt == lam or hi - lo <= 1e-15 * (abs(lo) + abs(hi)):
-                    break
-                lam = nxt
+            lam = _secular_root(g, w, length, lo, hi)
             for i in range(p):
                 bp[i] = g[i] / (w[i] + lam)
     cost = 0.0

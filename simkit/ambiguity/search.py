@@ -2,166 +2,179 @@
 
 The search runs depth-first over the decorrelated ambiguities from index ``n-1`` down to 0, visiting the integers
 of each level in order of distance from the conditional estimate (Schnorr-Euchner zig-zag), and shrinks the
-ellipsoid to the largest of the ``m`` best squared norms found once ``m`` candidates are held. It is exact:
-when it finishes, the candidates are the ``m`` integer vectors with the smallest ``(a_hat - a)^T Q^-1 (a_hat - a)``.
+ellipsoid to the largest of the ``m`` best costs found once ``m`` candidates are held. It is exact: when it
+finishes, the candidates are the ``m`` integer vectors with the smallest cost.
 
-The same kernel serves the baseline-constrained problems (``mode`` 1: one baseline of known length, ``mode`` 2:
-several baselines of known body-frame geometry): a leaf's cost is its squared norm plus the inner problem's
-minimum, and pruning on the partial squared norm stays valid because the inner minimum is non-negative.
+The cost of a leaf is computed by a ``leaf_cost`` function: :func:`ils_leaf` (the squared norm
+``(a_hat - a)^T Q^-1 (a_hat - a)``) here, the baseline-constrained costs in :mod:`.constrained`;
+:func:`make_search` builds the search for one of them. Pruning on
+the partial squared norm stays exact as long as the leaf cost is never below the squared norm.
+
+Compile time (why the kernels are shaped this way): numba compiles a kernel together with everything it calls.
+With the leaf cost chosen by a run-time ``mode``, a plain ``ils`` compiled the SO(3) and sphere fits (LAPACK SVD,
+solve, eigh) as well: about 14 s of a cold first call here. One search per leaf cost, built by
+:func:`make_search` with the leaf as a compile-time constant, lets ``ils`` compile only the squared norm, and the
+constrained kernels compile only when a constrained solver is called. (Passing the leaf function as a run-time
+argument instead would put a pointer to the Python dispatcher object into the machine code, which numba then
+refuses to cache.) The searches themselves are not cached: the entry kernels that embed them are.
 """
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from .decorrelation import (ERR_NONFINITE, ERR_NOT_PD, NOT_FINISHED, OK, as_problem, check_matrix, ltdl_into,
-                            raise_for_status, reduce_into)
+from .decorrelation import NOT_FINISHED, OK, as_problem, new_decorrelated, prepare, raise_for_status
 from .errors import AmbiguityInputError
-from .inner import rotation_fit, sphere_fit
+from .warmup import jit_when_ready
 
 DEFAULT_MAX_NODES = 10_000_000
-MODE_ILS, MODE_LENGTH, MODE_ATTITUDE = 0, 1, 2
 
 
-@njit(cache=True)
-def _leaf_cost(mode, dist, zhat, z, P, v, W, U, w, F, lengths, budget, out):
-    if mode == MODE_ILS:
-        return dist
-    p = v.shape[0]
-    n = zhat.shape[0]
-    c = v.copy()
-    for k in range(p):
-        s = 0.0
-        for i in range(n):
-            s += P[k, i] * (zhat[i] - z[i])
-        c[k] -= s
-    # cheap lower bound of the inner minimum: |x_j| = l_j on the constraint, so |c_j - x_j| >= | |c_j| - l_j |
-    lb = 0.0
-    for j in range(lengths.shape[0]):
-        nj = math.sqrt(c[3 * j] ** 2 + c[3 * j + 1] ** 2 + c[3 * j + 2] ** 2)
-        lb += (nj - lengths[j]) ** 2
-    if dist + w[0] * lb >= budget:
-        return math.inf
-    if mode == MODE_LENGTH:
-        return dist + sphere_fit(c, U, w, lengths[0], out)
-    return dist + rotation_fit(c, W, F, out)
+class Best(NamedTuple):
+    """The ``m`` best leaves found by :func:`search_into` (numba-compatible named tuple), best first at the end."""
+
+    cands: np.ndarray  # (m, n) float, integer-valued decorrelated ambiguities
+    costs: np.ndarray  # (m,) leaf costs (inf where fewer were found)
+    sols: np.ndarray  # (m, k) the leaf function's inner solution per candidate (k = 0 for plain ILS)
 
 
-@njit(cache=True)
-def search_into(zhat, L, d, max_nodes, mode, P, v, W, U, w, F, lengths, cands, costs, sols, chi2_start=math.inf):
-    """Search-and-shrink for the ``m = cands.shape[0]`` best integer vectors of the decorrelated problem.
+class Trail(NamedTuple):
+    """The search path, one entry per level ``k`` (the integers fixed so far and their conditional estimates)."""
 
-    Only costs below ``chi2_start`` are searched for (the search-and-expand strategy reruns with a larger one
-    when fewer than m were found).
+    acc: np.ndarray  # (n + 1, n): acc[k, j] = sum_{i >= k} L[i, j] (z_i - zc_i), j < k
+    dist: np.ndarray  # (n,): squared norm of levels k+1 .. n-1
+    zc: np.ndarray  # (n,) conditional float estimate of level k
+    z: np.ndarray  # (n,) integer tried at level k
+    step: np.ndarray  # (n,) next zig-zag step at level k
 
-    Fills ``cands`` (m, n) float (integer-valued, sorted by cost), ``costs`` (m,) and, for the constrained modes,
-    ``sols`` (m, k) with the inner solution of each candidate. Returns (status, nodes, n_found).
+
+@njit
+def ils_leaf(ctx, dist, w, z, budget, out):
+    """Leaf cost of plain ILS: the squared norm itself (``ctx`` unused)."""
+    return dist
+
+
+@njit
+def _enter(w, t, k, newdist):
+    """Descend to level ``k`` below a node of partial squared norm ``newdist``; returns the new residual."""
+    e = t.z[k + 1] - t.zc[k + 1]
+    for j in range(k + 1):
+        t.acc[k + 1, j] = t.acc[k + 2, j] + w.L[k + 1, j] * e
+    t.dist[k] = newdist
+    t.zc[k] = w.zhat[k] + t.acc[k + 1, k]
+    return _start_level(t, k)
+
+
+@njit
+def _start_level(t, k):
+    """Start level ``k`` at the integer nearest its conditional estimate; returns the residual zc - z."""
+    t.z[k] = math.floor(t.zc[k] + 0.5)
+    y = t.zc[k] - t.z[k]
+    t.step[k] = 1.0 if y >= 0.0 else -1.0
+    return y
+
+
+@njit
+def _zigzag(t, k):
+    """Move level ``k`` to its next integer (alternating around the estimate); returns the new residual."""
+    t.z[k] += t.step[k]
+    t.step[k] = -t.step[k] - (1.0 if t.step[k] > 0.0 else -1.0)
+    return t.zc[k] - t.z[k]
+
+
+@njit
+def _worst(costs):
+    """Index of the largest held cost (the first one on ties)."""
+    slot = 0
+    for i in range(1, costs.shape[0]):
+        if costs[i] > costs[slot]:
+            slot = i
+    return slot
+
+
+@njit
+def _keep(best, found, z, out, cost, chi2):
+    """Store a leaf among the best, in place of the worst once all ``m`` are held; returns (found, new bound).
+
+    The bound stays ``chi2`` until ``m`` leaves are held, then it is the largest held cost (the shrink).
+    Explicit loops rather than slice assignment and ``max()``: same speed, a fraction of the compile time.
     """
-    m, n = cands.shape
-    acc = np.zeros((n + 1, n))  # acc[k, j] = sum_{i >= k} L[i, j] (z_i - zc_i), j < k
-    dist = np.zeros(n)  # dist[k]: squared norm of levels k+1 .. n-1
-    zc = np.empty(n)
-    z = np.empty(n)
-    step = np.empty(n)
-    out = np.empty(sols.shape[1])
-    for i in range(m):
-        costs[i] = math.inf
-    found = 0
-    worst = 0
-    chi2 = chi2_start
-    k = n - 1
-    zc[k] = zhat[k]
-    z[k] = math.floor(zc[k] + 0.5)
-    y = zc[k] - z[k]
-    step[k] = 1.0 if y >= 0.0 else -1.0
-    nodes = 0
-    status = OK
-    while True:
-        nodes += 1
-        if nodes > max_nodes:
-            status = NOT_FINISHED
-            break
-        newdist = dist[k] + y * y / d[k]
-        if newdist < chi2:
-            if k > 0:
-                e = z[k] - zc[k]
-                for j in range(k):
-                    acc[k, j] = acc[k + 1, j] + L[k, j] * e
-                k -= 1
-                dist[k] = newdist
-                zc[k] = zhat[k] + acc[k + 1, k]
-                z[k] = math.floor(zc[k] + 0.5)
-                y = zc[k] - z[k]
-                step[k] = 1.0 if y >= 0.0 else -1.0
-                continue
-            cost = _leaf_cost(mode, newdist, zhat, z, P, v, W, U, w, F, lengths, chi2, out)
-            if cost < chi2:
-                slot = found if found < m else worst
-                for i in range(n):
-                    cands[slot, i] = z[i]
-                for i in range(out.shape[0]):
-                    sols[slot, i] = out[i]
-                costs[slot] = cost
-                if found < m:
-                    found += 1
-                if found == m:
-                    worst = 0
-                    for i in range(1, m):
-                        if costs[i] > costs[worst]:
-                            worst = i
-                    chi2 = costs[worst]
-            z[0] += step[0]
-            y = zc[0] - z[0]
-            step[0] = -step[0] - (1.0 if step[0] > 0.0 else -1.0)
-        else:
-            if k == n - 1:
-                break
-            k += 1
-            z[k] += step[k]
-            y = zc[k] - z[k]
-            step[k] = -step[k] - (1.0 if step[k] > 0.0 else -1.0)
-    # sort by cost (insertion sort; m is small)
-    for i in range(1, m):
+    m = best.costs.shape[0]
+    slot = found if found < m else _worst(best.costs)
+    for i in range(z.shape[0]):
+        best.cands[slot, i] = z[i]
+    for i in range(out.shape[0]):
+        best.sols[slot, i] = out[i]
+    best.costs[slot] = cost
+    found = min(found + 1, m)
+    return found, (chi2 if found < m else best.costs[_worst(best.costs)])
+
+
+@njit
+def _sort_best(best):
+    """Sort the held leaves by cost (insertion sort; m is small)."""
+    for i in range(1, best.costs.shape[0]):
         j = i
-        while j > 0 and costs[j] < costs[j - 1]:
-            costs[j], costs[j - 1] = costs[j - 1], costs[j]
-            for q in range(n):
-                cands[j, q], cands[j - 1, q] = cands[j - 1, q], cands[j, q]
-            for q in range(sols.shape[1]):
-                sols[j, q], sols[j - 1, q] = sols[j - 1, q], sols[j, q]
+        while j > 0 and best.costs[j] < best.costs[j - 1]:
+            best.costs[j], best.costs[j - 1] = best.costs[j - 1], best.costs[j]
+            for q in range(best.cands.shape[1]):
+                best.cands[j, q], best.cands[j - 1, q] = best.cands[j - 1, q], best.cands[j, q]
+            for q in range(best.sols.shape[1]):
+                best.sols[j, q], best.sols[j - 1, q] = best.sols[j - 1, q], best.sols[j, q]
             j -= 1
-    return status, nodes, found
 
 
-@njit(cache=True)
-def prepare(a, Q, L, d, Z, Zti, zhat):
-    """Check, factorise and decorrelate; fill zhat = Z^T (a - shift). Returns (code, i, j, shift (n,) int64)."""
-    n = a.shape[0]
-    shift = np.empty(n, dtype=np.int64)
-    for r in range(n):
-        if not math.isfinite(a[r]):
-            return ERR_NONFINITE, -1, r, shift
-    code, i, j = check_matrix(Q)
-    if code != OK:
-        return code, i, j, shift
-    bad = ltdl_into(Q, L, d)
-    if bad >= 0:
-        return ERR_NOT_PD, bad, 0, shift
-    for r in range(n):
-        for c in range(n):
-            Z[r, c] = 1 if r == c else 0
-            Zti[r, c] = 1 if r == c else 0
-    reduce_into(L, d, Z, Zti)
-    for r in range(n):
-        shift[r] = np.int64(math.floor(a[r] + 0.5))
-    for c in range(n):
-        s = 0.0
-        for r in range(n):
-            s += Z[r, c] * (a[r] - shift[r])
-        zhat[c] = s
-    return OK, 0, 0, shift
+def make_search(leaf_cost):
+    """:func:`search_into` specialised for one leaf-cost function (numba compiles it in as a direct call)."""
+
+    @njit
+    def search_into(ctx, w, best, max_nodes, chi2_start=math.inf):
+        """Search-and-shrink for the ``m`` best integer vectors of the decorrelated problem ``w``.
+
+        ``leaf_cost(ctx, dist, w, z, budget, out)`` gives a leaf's cost from its squared norm ``dist`` (it may
+        return inf when the cost cannot beat ``budget``) and writes its inner solution into ``out``. Only costs
+        below ``chi2_start`` are searched for (search-and-expand reruns with a larger one when fewer than m were
+        found). Fills ``best`` (:class:`Best`), sorted by cost. Returns (status, nodes, n_found).
+        """
+        n = w.d.shape[0]
+        t = Trail(np.zeros((n + 1, n)), np.zeros(n), np.empty(n), np.empty(n), np.empty(n))
+        out = np.empty(best.sols.shape[1])
+        for i in range(best.costs.shape[0]):
+            best.costs[i] = math.inf
+        found, chi2, nodes, status = 0, chi2_start, 0, OK
+        k = n - 1
+        t.zc[k] = w.zhat[k]
+        y = _start_level(t, k)
+        while True:
+            nodes += 1
+            if nodes > max_nodes:
+                status = NOT_FINISHED
+                break
+            newdist = t.dist[k] + y * y / w.d[k]
+            if newdist < chi2:
+                if k > 0:
+                    k -= 1
+                    y = _enter(w, t, k, newdist)
+                    continue
+                cost = leaf_cost(ctx, newdist, w, t.z, chi2, out)
+                if cost < chi2:
+                    found, chi2 = _keep(best, found, t.z, out, cost, chi2)
+                y = _zigzag(t, 0)
+            else:
+                if k == n - 1:
+                    break
+                k += 1
+                y = _zigzag(t, k)
+        _sort_best(best)
+        return status, nodes, found
+
+    return search_into
+
+
+ils_search = make_search(ils_leaf)
 
 
 @njit(cache=True)
@@ -178,66 +191,48 @@ def back_transform(cz, Zti, shift):
     return out
 
 
-_E1 = np.empty(0)
-_E2 = np.empty((0, 0))
-
-
 @njit(cache=True)
-def prepare_new(a, Q):
-    """:func:`prepare` into freshly allocated work arrays; returns (code, i, j, shift, L, d, Z, Zti, zhat)."""
-    n = a.shape[0]
-    L = np.empty((n, n))
-    d = np.empty(n)
-    Z = np.empty((n, n), dtype=np.int64)
-    Zti = np.empty((n, n), dtype=np.int64)
-    zhat = np.empty(n)
-    code, i, j, shift = prepare(a, Q, L, d, Z, Zti, zhat)
-    return code, i, j, shift, L, d, Z, Zti, zhat
-
-
-@njit(cache=True)
-def _ils_kernel(a, Q, m, max_nodes, e1, e2):
-    n = a.shape[0]
-    code, i, j, shift, L, d, Z, Zti, zhat = prepare_new(a, Q)
-    cz = np.zeros((m, n))
-    costs = np.full(m, math.inf)
+def _ils_kernel(a, Q, m, max_nodes):
+    w = new_decorrelated(a.shape[0])
+    best = Best(np.zeros((m, a.shape[0])), np.full(m, math.inf), np.empty((m, 0)))
+    code, i, j = prepare(a, Q, w)
     nodes = 0
-    found = 0
     if code == OK:
-        code, nodes, found = search_into(zhat, L, d, max_nodes, MODE_ILS, e2, e1, e2, e2, e1, e2, e1, cz, costs,
-                                         np.empty((m, 0)))
-    return code, i, j, back_transform(cz, Zti, shift), costs, Z, Zti, L, d, zhat, shift, nodes, found
+        code, nodes, _ = ils_search(None, w, best, max_nodes)
+    # the work arrays go back flat, not as a Decorrelated: ils() only unpacks them, and boxing a named tuple
+    # costs a Python call per solve (n = 10 solves take ~6 us in all)
+    cands = back_transform(best.cands, w.Zti, w.shift)
+    return code, i, j, cands, best.costs, nodes, w.L, w.d, w.Z, w.Zti, w.zhat, w.shift
 
 
 @njit(cache=True)
-def _ils_batch_kernel(A, Qs, m, max_nodes, e1, e2):
+def _ils_batch_kernel(A, Qs, m, max_nodes):
     K, n = A.shape
     cands = np.zeros((K, m, n), dtype=np.int64)
     costs = np.full((K, m), math.inf)
     status = np.zeros(K, dtype=np.int64)
     nodes = np.zeros(K, dtype=np.int64)
     dd = np.empty((K, n))
-    err = np.zeros(3, dtype=np.int64)  # first bad epoch, i, j
-    err[0] = -1
-    L = np.empty((n, n))
-    Z = np.empty((n, n), dtype=np.int64)
-    Zti = np.empty((n, n), dtype=np.int64)
-    zhat = np.empty(n)
-    cz = np.zeros((m, n))
-    sols = np.empty((m, 0))
+    err = np.full(3, -1, dtype=np.int64)  # first bad epoch, i, j
+    w = new_decorrelated(n)
+    cz, sols = np.zeros((m, n)), np.empty((m, 0))
     for k in range(K):
-        d = dd[k]
-        code, i, j, shift = prepare(A[k], Qs[k if Qs.shape[0] > 1 else 0], L, d, Z, Zti, zhat)
+        best = Best(cz, costs[k], sols)
+        code, i, j = prepare(A[k], Qs[k if Qs.shape[0] > 1 else 0], w)
+        dd[k] = w.d
+        status[k] = code
         if code != OK:
-            status[k] = code
             if err[0] < 0:
                 err[0], err[1], err[2] = k, i, j
             continue
-        code, nodes[k], _ = search_into(zhat, L, d, max_nodes, MODE_ILS, e2, e1, e2, e2, e1, e2, e1, cz,
-                                        costs[k], sols)
-        status[k] = code
-        cands[k] = back_transform(cz, Zti, shift)
+        status[k], nodes[k], _ = ils_search(None, w, best, max_nodes)
+        cands[k] = back_transform(best.cands, w.Zti, w.shift)
     return cands, costs, status, nodes, dd, err
+
+
+# Interpreted up to n = 40 while the kernel compiles: 0.1 ms (n = 3) to ~0.1 s (n = 40, badly conditioned) per
+# solve here, against 4-6 s of compilation (see .warmup).
+_ILS = jit_when_ready(_ils_kernel, lambda a, *_: a.shape[0], max_interpreted_n=40)
 
 
 class ILSResult:
@@ -266,8 +261,16 @@ class ILSResult:
 
     @property
     def ratio(self) -> float:
-        """sqnorm(2nd) / sqnorm(best), the ratio-test statistic (>= 1)."""
-        return float(self.sqnorms[1] / self.sqnorms[0])
+        """sqnorm(2nd) / sqnorm(best), the ratio-test statistic (>= 1).
+
+        NaN when solved with ``n_cands=1``: the statistic needs a second candidate that was never searched for,
+        and NaN fails every ``ratio >= threshold`` comparison, so no fix is accepted on it. (inf when a second
+        candidate was asked for but none exists within the work cap, or when the best norm is 0.)
+        """
+        if self.sqnorms.shape[0] < 2:
+            return math.nan
+        s0, s1 = float(self.sqnorms[0]), float(self.sqnorms[1])
+        return math.inf if s0 == 0.0 else s1 / s0
 
     @property
     def Qz(self):
@@ -298,8 +301,7 @@ def ils(a_hat, Q, n_cands=2, max_nodes=DEFAULT_MAX_NODES) -> ILSResult:
             and a.ndim == 1 and a.size and Qm.shape == (a.size, a.size) and a.flags.c_contiguous
             and Qm.flags.c_contiguous):
         a, Qm = as_problem(a_hat, Q)  # converts, or raises naming the wrong shape
-    code, i, j, cands, costs, Z, Zti, L, d, zhat, shift, nodes, _ = _ils_kernel(a, Qm, int(n_cands),
-                                                                                int(max_nodes), _E1, _E2)
+    code, i, j, cands, costs, nodes, L, d, Z, Zti, zhat, shift = _ILS.call(a, Qm, int(n_cands), int(max_nodes))
     if code < 0:
         raise_for_status(code, i, j)
     return ILSResult(cands, costs, code == OK, nodes, Z, Zti, L, d, zhat, shift)
@@ -338,7 +340,7 @@ def ils_batch(a_hat, Q, n_cands=2, max_nodes=DEFAULT_MAX_NODES):
         Qs = Qs[None]
     if Qs.shape[1:] != (A.shape[1], A.shape[1]) or Qs.shape[0] not in (1, A.shape[0]):
         raise AmbiguityInputError("Q", f"shape {Qs.shape}; expected {(A.shape[0], A.shape[1], A.shape[1])}")
-    cands, costs, status, nodes, d, err = _ils_batch_kernel(A, Qs, int(n_cands), int(max_nodes), _E1, _E2)
+    cands, costs, status, nodes, d, err = _ils_batch_kernel(A, Qs, int(n_cands), int(max_nodes))
     if err[0] >= 0:
         raise_for_status(int(status[err[0]]), int(err[1]), int(err[2]), what=f"[{int(err[0])}]")
     return ILSBatchResult(cands, costs, status == OK, nodes, d)
@@ -354,7 +356,7 @@ def _ils_list(a_list, Q_list, n_cands, max_nodes):
         idx = np.flatnonzero(sizes == n)
         A = np.stack([probs[k][0] for k in idx])
         Qs = np.stack([probs[k][1] for k in idx])
-        cands, costs, status, _, _, err = _ils_batch_kernel(A, Qs, n_cands, max_nodes, _E1, _E2)
+        cands, costs, status, _, _, err = _ils_batch_kernel(A, Qs, n_cands, max_nodes)
         if err[0] >= 0:
             raise_for_status(int(status[err[0]]), int(err[1]), int(err[2]), what=f"[{int(idx[err[0]])}]")
         for r, k in enumerate(idx):

@@ -13,6 +13,7 @@ from scipy.stats import chi2
 
 from .decorrelation import decorrelate, ltdl
 from .errors import AmbiguityInputError
+from .estimators import bootstrap_z, round_half_up
 
 
 def _cond_variances(Q, decorrelate_first):
@@ -93,16 +94,8 @@ def monte_carlo_success_rate(Q, n_samples, rng, estimator="ils"):
     elif estimator in ("bootstrap", "rounding"):
         dec = decorrelate(Qm)
         z = e @ dec.Z.astype(np.float64)
-        if estimator == "rounding":
-            ok = np.all(np.floor(z + 0.5) == 0, axis=1)
-        else:
-            ok = np.ones(len(z), bool)
-            acc = np.zeros_like(z)  # sum_{j>k} L_jk (z_j - zc_j), accumulated level by level
-            for k in range(n - 1, -1, -1):
-                zc = z[:, k] + acc[:, k]
-                zi = np.floor(zc + 0.5)
-                ok &= zi == 0
-                acc[:, :k] += np.outer(zi - zc, dec.L[k, :k])
+        fixed = round_half_up(z) if estimator == "rounding" else bootstrap_z(z, dec.L)
+        ok = np.all(fixed == 0, axis=1)
     else:
         raise AmbiguityInputError("estimator", f"{estimator!r}; expected 'ils', 'bootstrap' or 'rounding'")
     p = float(np.mean(ok))

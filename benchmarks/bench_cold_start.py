@@ -1,0 +1,99 @@
+"""Cold and warm start of simkit.ambiguity.ils and of `simkit run quickstart`, each in a fresh subprocess.
+
+Run: python benchmarks/bench_cold_start.py [--repeat N]. "cold" = an empty NUMBA_CACHE_DIR (as right after
+install); "warm" = the same directory once a process has compiled and cached the kernels. Columns:
+- import: `from simkit.ambiguity import ils`;
+- first ils: the first call (n = 10, a GNSS-like problem); cold, it runs the kernel interpreted while numba
+  compiles in the background (simkit/ambiguity/warmup.py);
+- compiled after: from the first call until the compiled kernel is in use (compilation, or the cache load);
+- quickstart: wall time of `python -m simkit run quickstart -o <tmp>` (other stages compile their own kernels;
+  reported, not a target). Medians over --repeat runs.
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+CHILD = """
+import json, time
+t0 = time.perf_counter()
+import numpy as np
+from simkit.ambiguity import ils
+from simkit.ambiguity.problems import random_problem
+from simkit.ambiguity.warmup import wait_for_jit
+t1 = time.perf_counter()
+a, Q, _ = random_problem(np.random.default_rng(1), 10, "well")
+t2 = time.perf_counter()
+ils(a, Q)
+t3 = time.perf_counter()
+wait_for_jit()
+t4 = time.perf_counter()
+print(json.dumps({"import": t1 - t0, "first_ils": t3 - t2, "compiled_after": t4 - t2}))
+"""
+
+
+def _env(cache_dir):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir))
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
+    return env
+
+
+def first_ils(cache_dir):
+    """{import, first_ils, compiled_after} in seconds, from a fresh interpreter."""
+    out = subprocess.run([sys.executable, "-c", CHILD], env=_env(cache_dir), capture_output=True, text=True,
+                         check=True, timeout=600)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def quickstart(cache_dir):
+    """Wall time (s) of `python -m simkit run quickstart -o <tmp>` in a fresh interpreter."""
+    with tempfile.TemporaryDirectory() as tmp:
+        t = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "simkit", "run", "quickstart", "-o", str(Path(tmp) / "q.h5")],
+                       env=_env(cache_dir), capture_output=True, check=True, timeout=1200)
+        return time.perf_counter() - t
+
+
+def _median(xs):
+    xs = sorted(xs)
+    return xs[len(xs) // 2]
+
+
+def measure(repeat=3):
+    """Rows {state, import, first_ils, compiled_after, quickstart}: medians over ``repeat`` fresh processes."""
+    rows = {"cold": [], "warm": []}
+    for _ in range(repeat):
+        cache = Path(tempfile.mkdtemp(prefix="simkit-numba-"))
+        try:
+            cold = first_ils(cache)  # empty cache; the child waits for the compilation, which fills it
+            warm = first_ils(cache)
+            shutil.rmtree(cache)
+            cache.mkdir()
+            cold["quickstart"] = quickstart(cache)
+            warm["quickstart"] = quickstart(cache)
+        finally:
+            shutil.rmtree(cache, ignore_errors=True)
+        rows["cold"].append(cold)
+        rows["warm"].append(warm)
+    return [{"state": s, **{k: _median([r[k] for r in rs]) for k in rs[0]}} for s, rs in rows.items()]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    rows = measure(ap.parse_args().repeat)
+    print(f"{'numba cache':<12} {'import s':>9} {'first ils s':>12} {'compiled after s':>17} {'quickstart s':>13}")
+    for r in rows:
+        print(f"{r['state']:<12} {r['import']:>9.2f} {r['first_ils']:>12.3f} {r['compiled_after']:>17.2f} "
+              f"{r['quickstart']:>13.1f}")
+
+
+if __name__ == "__main__":
+    main()
