@@ -22,6 +22,7 @@ from .scenario import Scenario, load, resolve
 from .trajectory import Trajectory
 
 BLOCK_SAMPLES = 1 << 16
+GNSS_CELLS = 1 << 20  # ~8 MB per (M, A, S) float array handed from the GNSS stage to the writer
 MAX_OUTPUT_BYTES = 100 * 2**30  # refuse larger runs unless forced: a typo in duration_s, not a dataset
 _SKY_CHECK_STEP_S = 60.0
 _SKY_CHECK_MAX = 1440
@@ -183,17 +184,25 @@ def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress
             rows = _rows("truth", truth)
             if stages.imu is not None:
                 rows.update(_imu_rows(truth.t, stages.imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)))
-            if stages.gnss is not None:
-                idx = np.nonzero((np.arange(k, k + len(truth.t)) % stride) == 0)[0]
-                if idx.size:
-                    sub = truth.take(idx)
-                    rows.update(gnss_rows(stages.gnss.process(sub.t, sub.pos_ecef, sub.vel_ecef(), sub.quat_nb,
-                                                               sub.omega_ib_b)))
             for path, data in rows.items():
                 w.append(path, data)
+            if stages.gnss is not None:
+                _write_gnss(w, stages.gnss, truth, np.nonzero((np.arange(k, k + len(truth.t)) % stride) == 0)[0])
             k += len(truth.t)
             if bar is not None:
                 bar.update(len(truth.t))
     finally:
         if bar is not None:
             bar.close()
+
+
+def _write_gnss(w: Writer, gnss: GnssSimulator, truth, idx: np.ndarray) -> None:
+    """GNSS epochs ``idx`` of a truth block, in slices of at most :data:`GNSS_CELLS` (epoch, antenna, satellite,
+    signal) cells, so memory stays bounded when the GNSS rate approaches the truth rate."""
+    per_epoch = gnss.n_ant * len(gnss.sat_ids) * len(gnss.signals)
+    step = max(1, GNSS_CELLS // max(1, per_epoch))
+    for start in range(0, idx.size, step):
+        sub = truth.take(idx[start:start + step])
+        for path, data in gnss_rows(gnss.process(sub.t, sub.pos_ecef, sub.vel_ecef(), sub.quat_nb,
+                                                 sub.omega_ib_b)).items():
+            w.append(path, data)

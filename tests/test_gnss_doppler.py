@@ -14,7 +14,7 @@ from simkit.earth import C_LIGHT
 CASES = {  # scenario -> (seconds simulated, what happens in them)
     "quickstart": 60.0,        # car: acceleration, 90 deg turn, weave
     "high_dynamic": 120.0,     # 5-7 g turns, 250 deg/s rolls, dives at 245 m/s
-    "airborne_stim300": 240.0,  # take-off run and climb
+    "airborne_stim300": 150.0,  # take-off run and climb
 }
 
 
