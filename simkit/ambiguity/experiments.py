@@ -17,12 +17,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..gnss.differencing import dd_covariance, double_difference, reference_satellites
+from ..gnss.signals import SIGNALS
 from ..rng import generator
 from .constrained import baseline_constrained_ils
 from .search import ils_batch
 from .success import bootstrap_success_rate
 
-GPS_L1_WAVELENGTH_M = 299_792_458.0 / 1575.42e6
+GPS_L1_WAVELENGTH_M = SIGNALS["L1C"].wavelength_m
 
 
 @dataclass(frozen=True)

@@ -23,14 +23,15 @@ import numpy as np
 from .. import earth
 from ..earth import C_LIGHT
 from ..gpstime import BDT_MINUS_GPST
+from .signals import SIGNALS
 
 DEFAULT_GPS_ALPHA = (2.2352e-08, 1.4901e-08, -1.1921e-07, -5.9605e-08)
 DEFAULT_GPS_BETA = (1.2493e05, 6.5536e04, -1.9661e05, 6.5536e04)
 DEFAULT_BDS_ALPHA = (3.3528e-08, 6.7055e-08, -1.0133e-06, 1.6093e-06)
 DEFAULT_BDS_BETA = (1.1878e05, 3.2768e04, 7.8643e05, -7.8643e05)
 
-F_L1 = 1575.42e6
-F_B1I = 1561.098e6
+F_L1 = SIGNALS["L1C"].freq_hz   # reference frequency of the GPS broadcast model
+F_B1I = SIGNALS["B1I"].freq_hz  # reference frequency of the BDS broadcast model
 
 
 def _poly(c, x):
