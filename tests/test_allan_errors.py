@@ -80,7 +80,8 @@ def test_plot_without_matplotlib_names_the_extra(files, tmp_path, monkeypatch):
     (blocker / "matplotlib").mkdir(parents=True)
     (blocker / "matplotlib" / "__init__.py").write_text("raise ImportError('matplotlib is not installed')\n")
     monkeypatch.setenv("PYTHONPATH", str(blocker))
-    assert_clean_error(["allan", str(files["good"]), "--plot", "adev.png"], tmp_path, expect="'simkit[plot]'")
+    assert_clean_error(["allan", str(files["good"]), "--plot", "adev.png"], tmp_path, expect="'simkit[plot]'",
+                       isolated=True)
 
 
 def test_closed_pipe_is_quiet(files, tmp_path):

@@ -74,6 +74,7 @@ print(json.dumps({"first_s": first, "cands": res.candidates.tolist(), "again": a
 """
 
 
+@pytest.mark.slow
 def test_cold_first_ils_call_is_fast_and_right(tmp_path):
     case = VECTORS["large"]
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))  # empty: as right after install

@@ -59,6 +59,7 @@ def test_lazy_arrays_are_numpy_not_h5py(tmp_path):
         assert ids.dtype.kind == "U" and ids[0][0] in "GC" and len(ids[0]) == 3
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("hide_isal", [False, True])
 def test_both_deflate_paths_decode_through_hdf5(tmp_path, hide_isal):
     """ISA-L when installed, the standard library's zlib otherwise: HDF5's own filter decodes both."""
@@ -79,6 +80,7 @@ def test_both_deflate_paths_decode_through_hdf5(tmp_path, hide_isal):
     assert float(total) > 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
 def test_sigterm_and_sighup_remove_the_temporary_file(tmp_path, sig):
     out = tmp_path / "big.h5"

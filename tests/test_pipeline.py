@@ -84,6 +84,7 @@ def test_interrupted_run_leaves_no_file(tmp_path, monkeypatch):
     assert not out.exists() and not list(tmp_path.iterdir())
 
 
+@pytest.mark.slow
 def test_killed_process_leaves_nothing_under_the_output_name(tmp_path):
     out = tmp_path / "big.h5"
     proc = subprocess.Popen([sys.executable, "-m", "simkit", "run", "xian_static_bds", "-q", "-o", str(out),

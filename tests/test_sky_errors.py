@@ -73,7 +73,7 @@ def test_plot_without_matplotlib_names_the_plot_extra(tmp_path, monkeypatch):
     work = tmp_path / "work"
     work.mkdir()
     line = assert_clean_error(["sky", "nominal:gps", *SITE, "--plot", "sky.png"], work,
-                              expect="--plot: needs matplotlib")
+                              expect="--plot: needs matplotlib", isolated=True)
     assert "simkit[plot]" in line
 
 
