@@ -185,3 +185,36 @@ def test_no_function_over_60_lines():
                 if n > 60:
                     long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name} ({n} lines)")
     assert not long, "\n".join(long)
+
+
+def test_solutions_round_trip_and_replace_only_their_group(tmp_path):
+    from simkit.io import read_solution, solution_names, write_solution
+    from simkit.solution import Solution
+
+    path = simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=2"])
+    with simkit.open(path) as ds:
+        t, pos = ds["truth/t"][::10], ds["truth/pos_ecef"][::10]
+    k = t.size
+    sol = Solution(t=t, pos_ecef=pos, vel_enu=np.zeros((k, 3)), cov=np.tile(np.eye(2), (k, 1, 1)),
+                   state_names=("a", "b"), extras={"gamma": np.ones(k), "fixed": np.zeros((k, 4), dtype=np.int64)},
+                   extra_units={"gamma": "1"}, config={"filter": "test", "q": [1, 2]})
+    write_solution(path, "kf", sol)
+    write_solution(path, "other", sol)
+    write_solution(path, "kf", Solution(t=t[:3], pos_ecef=pos[:3] + 1.0))   # replaces only "kf"
+    assert solution_names(path) == ["kf", "other"]
+    back = read_solution(path, "other")
+    assert back.state_names == ("a", "b") and back.config == {"filter": "test", "q": [1, 2]}
+    np.testing.assert_array_equal(back.pos_ecef, pos)
+    np.testing.assert_array_equal(back.extras["fixed"], np.zeros((k, 4)))
+    assert back.extra_units["gamma"] == "1" and back.vel_enu.shape == (k, 3)
+    kf = read_solution(path, "kf")
+    assert kf.t.size == 3 and kf.vel_enu is None and not kf.extras
+    with simkit.open(path) as ds:
+        assert ds["solutions/kf/pos_ecef"].attrs["frame"] == "ECEF"
+        np.testing.assert_array_equal(ds["truth/pos_ecef"][::10], pos)   # the rest of the file untouched
+    with pytest.raises(ValueError, match="expected shape"):
+        Solution(t=t, pos_ecef=pos[:, :2])
+    from simkit.errors import DataFileError
+
+    with pytest.raises(DataFileError, match="no solution 'nope'"):
+        read_solution(path, "nope")

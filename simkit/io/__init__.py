@@ -3,7 +3,8 @@ reader, and the checks on an output path."""
 from .output import check_output
 from .reader import Array, Dataset, open_dataset
 from .schema import SCHEMA, SCHEMA_VERSION, Field, SchemaError, field
+from .solutions import read_solution, solution_names, write_solution
 from .writer import Writer
 
 __all__ = ["Array", "Dataset", "Field", "SCHEMA", "SCHEMA_VERSION", "SchemaError", "Writer", "check_output",
-           "field", "open_dataset"]
+           "field", "open_dataset", "read_solution", "solution_names", "write_solution"]

@@ -104,6 +104,11 @@ class Dataset:
         g = self._file.get(group or "/")
         return [k for k, v in g.items() if isinstance(v, h5py.Group)] if isinstance(g, h5py.Group) else []
 
+    def members(self, group: str) -> list[str]:
+        """Names of the datasets directly under ``group`` (empty when absent)."""
+        g = self._file.get(group)
+        return [k for k, v in g.items() if isinstance(v, h5py.Dataset)] if isinstance(g, h5py.Group) else []
+
     @property
     def scenario_name(self) -> str:
         return str(self.attrs.get("scenario_name", "?"))
