@@ -31,7 +31,10 @@ def ecef_to_lla(pos):
 
 
 def ecef_to_enu_matrix(lat, lon):
-    """Rotation matrices C_e^n (..., 3, 3) taking ECEF vectors to ENU at (lat, lon) in radians."""
+    """Rotation matrices C_e^n (..., 3, 3) taking ECEF vectors to ENU at (lat, lon) in radians.
+
+    Written out because the GNSS stage and the estimators need the matrices themselves (einsum over epochs x
+    antennas x satellites, and their rates); pymap3d's ``ecef2enuv`` rotates vectors one call per point set."""
     sl, cl = np.sin(lat), np.cos(lat)
     so, co = np.sin(lon), np.cos(lon)
     z = np.zeros_like(sl * so)

@@ -73,3 +73,25 @@ def test_rtklib_fixes_the_simulated_baseline(tmp_path):
           f"max error of fixed baseline {err.max() * 1e3:.2f} mm, last {err[-1] * 1e3:.2f} mm")
     assert fixed[-60:].all()
     assert err.max() < 0.01
+
+
+def test_marker_type_and_name_follow_the_vehicle(tmp_path):
+    """RINEX 3.04 MARKER TYPE: GEODETIC only for a static antenna; AIRBORNE for a climbing aircraft, GROUND_CRAFT
+    for a car; the marker name separates the stem from the antenna index."""
+    import simkit
+    from simkit.commands.rinex import run as rinex_cmd
+
+    cases = {"xian_static_bds": ("GEODETIC", ["scenario.duration_s=5"]),
+             "airborne_stim300": ("AIRBORNE", ["scenario.duration_s=200"]),
+             "quickstart": ("GROUND_CRAFT", ["scenario.duration_s=30"])}
+    for name, (kind, over) in cases.items():
+        path = simkit.run(name, out=tmp_path / f"{name}.h5", overrides=over)
+        out = tmp_path / name
+
+        class Args:
+            file, name = str(path), None
+        Args.out = str(out)
+        rinex_cmd(Args)
+        head = (out / f"{name}_ant0.rnx").read_text().split("END OF HEADER")[0]
+        assert f"{kind:<60}MARKER TYPE" in head, name
+        assert f"{name.upper()}_ANT0" in head
