@@ -1,8 +1,8 @@
 """IMU benchmark: 1 h at 1 kHz, six axes, every error term on, written to HDF5; peers measured in the same run.
 
 Prints our throughput, peak RSS, and the ratio against
-  (a) a straightforward per-sample reference implementation of the same error model (REFERENCE, written here:
-      the per-sample loop style of gnss-ins-sim, which is not installable from PyPI);
+  (a) gnss-ins-sim's IMU error generation (``pathgen.gyro_gen`` / ``acc_gen``: constant bias, first-order
+      Gauss-Markov bias drift, white noise; fewer terms than ours), from the shared peers folder (not on PyPI);
   (b) allantools' flicker-noise generator (Kasdin fractional-difference, allantools.noise.pink);
   (c) allantools.oadev against simkit.imu.allan.adev on the same record.
 Run: python benchmarks/bench_imu.py [--hours H] [--compression none|lzf|gzip]
@@ -22,6 +22,7 @@ import psutil
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout without installing
 
+import peers  # noqa: E402  (benchmarks/peers.py)
 from simkit.imu import ImuSimulator, parse_config
 from simkit.imu.allan import adev
 from simkit.section import Section
@@ -71,36 +72,18 @@ def run_ours(n, path, compression, all_errors):
     return t_imu, t_write, t_truth, n_sets
 
 
-def run_reference(n):
-    """REFERENCE per-sample implementation (not ours, not a peer's code): same terms, one Python step per sample."""
-    cfg = parse_config(Section(ALL_TERMS, "imu"))
-    rng = np.random.default_rng(1)
-    dt = 1.0 / RATE
-    out = np.empty((n, 6))
-    specs = (cfg.gyro, cfg.accel)
-    # flicker as 11 independent first-order Gauss-Markov processes per axis (the usual per-sample approach)
-    taus = np.logspace(-1, 4, 11)
-    phis = np.exp(-dt / taus)
-    state = {"fl": np.zeros((2, 3, 11)), "rw": np.zeros((2, 3)), "gm": np.zeros((2, 3)), "res": np.zeros((2, 3))}
-    for k in range(n):
-        t = k * dt
-        omega, f = truth_block(np.array([t]))
-        for s, (spec, x) in enumerate(zip(specs, (omega[0], f[0]))):
-            for a in range(3):
-                fl = state["fl"][s, a]
-                fl[:] = phis * fl + spec.bias_instability * np.sqrt(1 - phis**2) * rng.standard_normal(11)
-                state["rw"][s, a] += spec.rate_random_walk * math.sqrt(dt) * rng.standard_normal()
-                gm = spec.gauss_markov[0]
-                state["gm"][s, a] = (math.exp(-dt / gm.tau_s) * state["gm"][s, a]
-                                     + gm.sigma * math.sqrt(1 - math.exp(-2 * dt / gm.tau_s)) * rng.standard_normal())
-                y = (x[a] * (1 + spec.scale_factor) + fl.sum() + state["rw"][s, a] + state["gm"][s, a]
-                     + spec.random_walk / math.sqrt(dt) * rng.standard_normal())
-                y = min(max(y, -spec.range), spec.range)
-                acc = state["res"][s, a] + y * dt
-                q = math.floor(acc / spec.quantization + 0.5) * spec.quantization
-                state["res"][s, a] = acc - q
-                out[k, 3 * s + a] = q / dt
-    return out
+def gnss_ins_sim_rate(pathgen, n: int) -> float:
+    """Axis-samples/s of gnss-ins-sim's gyro_gen + acc_gen on n samples of the same truth (bias, Gauss-Markov
+    drift of 30 s / 60 s as in ALL_TERMS, white noise)."""
+    omega, f = truth_block(np.arange(n) / RATE)
+    gyro_err = {"b": np.full(3, 1e-5), "b_drift": np.full(3, 1e-5), "b_corr": np.full(3, 30.0),
+                "arw": np.full(3, 1e-4)}
+    acc_err = {"b": np.full(3, 1e-3), "b_drift": np.full(3, 5e-4), "b_corr": np.full(3, 60.0),
+               "vrw": np.full(3, 1e-3)}
+    t0 = time.perf_counter()
+    pathgen.gyro_gen(RATE, omega, gyro_err)
+    pathgen.acc_gen(RATE, f, acc_err)
+    return 6 * n / (time.perf_counter() - t0)
 
 
 def main(argv=None) -> int:
@@ -136,14 +119,15 @@ def main(argv=None) -> int:
 
 
 def compare(ours_rate: float) -> None:
-    """The reference loop, allantools' flicker generator and allantools.oadev, timed in this run."""
-    n_ref = 20_000
-    t0 = time.perf_counter()
-    run_reference(n_ref)
-    t_ref = time.perf_counter() - t0
-    ref_rate = 6 * n_ref / t_ref
-    print(f"REFERENCE per-sample loop (same model, written for this benchmark; gnss-ins-sim is not on PyPI): "
-          f"{ref_rate / 1e6:.3f} M axis-samples/s -> simkit generation is {ours_rate / ref_rate:.0f}x faster")
+    """gnss-ins-sim's IMU error generation, allantools' flicker generator and allantools.oadev, timed in this run."""
+    pathgen = peers.gnss_ins_sim()
+    if pathgen is None:
+        print("gnss-ins-sim not found (looked in: " + ", ".join(str(p) for p in peers.CANDIDATES) + ")")
+    else:
+        peer_rate = gnss_ins_sim_rate(pathgen, 200_000)
+        print(f"gnss-ins-sim gyro_gen + acc_gen (bias, Gauss-Markov drift, white noise only), 200,000 samples: "
+              f"{peer_rate / 1e6:.3f} M axis-samples/s -> simkit generation (every term) is "
+              f"{ours_rate / peer_rate:.0f}x faster")
 
     import allantools
 

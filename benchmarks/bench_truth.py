@@ -23,12 +23,12 @@ import psutil
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # this checkout first
 
+import peers  # noqa: E402  (benchmarks/peers.py)
 from simkit import run  # noqa: E402
 from simkit.scenario.loader import load  # noqa: E402
 from simkit.trajectory import Trajectory  # noqa: E402
 
 HIGH_DYNAMIC = ROOT / "scenarios" / "high_dynamic.toml"
-PEER_CANDIDATES = [p / "shared" / "peers" / "gnss-ins-sim" for p in (ROOT.parent, ROOT.parent.parent)]
 
 
 def truth_only_scenario(seconds: float, rate: float) -> dict:
@@ -65,18 +65,8 @@ def ours(seconds: float, rate: float) -> tuple[float, float, int]:
     return n / with_write, n / alone, size
 
 
-def find_peer(path: str | None) -> Path | None:
-    for p in ([Path(path)] if path else PEER_CANDIDATES):
-        if (p / "gnss_ins_sim" / "pathgen" / "pathgen.py").is_file():
-            return p
-    return None
-
-
-def gnss_ins_sim_rate(peer: Path, seconds: float, rate: float) -> float:
+def gnss_ins_sim_rate(pathgen, seconds: float, rate: float) -> float:
     """gnss-ins-sim's path_gen (NED, 1x over-sampling, no GPS / odometer): samples/s on turns, rolls, a climb."""
-    sys.path.insert(0, str(peer))
-    from gnss_ins_sim.pathgen import pathgen
-
     d2r = math.pi / 180.0
     initial = np.array([40.0 * d2r, 116.0 * d2r, 4000.0, 200.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     # type 1 rows: [type, yaw rate, pitch rate, roll rate (deg/s), body accel x, y, z (m/s^2), duration s, gps]
@@ -109,13 +99,13 @@ def main(argv=None) -> int:
     print(f"simkit truth generation alone: {alone:,.0f} samples/s")
     print(f"target >= 1,000,000 samples/s with the write: {'met' if with_write >= 1e6 else 'NOT met'}; "
           f"peak RSS < 1 GiB: {'met' if peak < 2**30 else 'NOT met'}")
-    peer = find_peer(args.peer)
-    if peer is None:
-        print("gnss-ins-sim not found (looked in: " + ", ".join(str(p) for p in PEER_CANDIDATES)
+    pathgen = peers.gnss_ins_sim(args.peer)
+    if pathgen is None:
+        print("gnss-ins-sim not found (looked in: " + ", ".join(str(p) for p in peers.CANDIDATES)
               + "): no peer figure")
         return 0
-    theirs = gnss_ins_sim_rate(peer, args.peer_seconds, args.rate)
-    print(f"gnss-ins-sim {peer.name} pathgen.path_gen, {args.peer_seconds:g} s at {args.rate:g} Hz: "
+    theirs = gnss_ins_sim_rate(pathgen, args.peer_seconds, args.rate)
+    print(f"gnss-ins-sim pathgen.path_gen, {args.peer_seconds:g} s at {args.rate:g} Hz: "
           f"{theirs:,.0f} samples/s (truth only, in memory)")
     print(f"ratio simkit / gnss-ins-sim: {alone / theirs:.0f}x generation alone, {with_write / theirs:.0f}x "
           f"with our HDF5 write")
