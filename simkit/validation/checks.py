@@ -16,20 +16,20 @@ ANGLE_PAIRS = ((0, 1), (0, 2), (1, 2))
 
 
 def c1_error(L, sigma, atd) -> tuple[np.ndarray, np.ndarray]:
-    """C1 (Theorem 1): ATDOP from the SVD vs sqrt(diag(L^+)) by numpy's pseudo-inverse (its inverse for full
-    rank), on the angles with a finite ATDOP. Returns the worst relative error (N,) and its allowance (N,):
-    1e3 eps cond(L) restricted to the observable subspace (rounding of both paths), at least 1e-9."""
+    """C1 (Theorem 1): ATDOP from the SVD vs sqrt(diag(L^+)) by numpy (LU inverse for full rank, SVD-based
+    pseudo-inverse otherwise), on the angles with a finite ATDOP. Returns the worst relative error (N,) and its
+    allowance (N,): 1e3 eps cond(L) on the observable subspace (rounding of both paths), at least 1e-9."""
     full = sigma[:, -1] > RANK_RTOL * sigma[:, 0]
     inv = np.empty_like(L)
     if full.any():
         inv[full] = np.linalg.inv(L[full])
     if (~full).any():
-        inv[~full] = np.linalg.pinv(L[~full], rcond=RANK_RTOL, hermitian=True)
+        inv[~full] = np.linalg.pinv(L[~full], rcond=RANK_RTOL, hermitian=False)
     ref = np.sqrt(np.clip(np.diagonal(inv, axis1=-2, axis2=-1), 0.0, None))
     finite = np.isfinite(atd)
     rel = np.where(finite, np.abs(atd - ref) / np.where(ref > 0, ref, 1.0), 0.0).max(axis=-1)
-    smallest = np.where(full, sigma[:, -1], np.where(sigma[:, 1] > RANK_RTOL * sigma[:, 0], sigma[:, 1], sigma[:, 0]))
-    allow = np.maximum(1e-9, 1e3 * EPS * sigma[:, 0] / np.maximum(smallest, 1e-300))
+    kept = np.where(sigma > RANK_RTOL * sigma[:, :1], sigma, np.inf).min(axis=-1)
+    allow = np.maximum(1e-9, 1e3 * EPS * sigma[:, 0] / kept)
     return rel, allow
 
 
