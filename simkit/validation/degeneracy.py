@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .jacobi import sym_eig3
+
 DEGENERACY_TOL_RAD = 1e-3
 
 REASONS = {
@@ -42,9 +44,14 @@ def _ratio_angle(num, tr):
     return np.sqrt(np.clip(num, 0.0, None) / np.where(tr > 0, tr, 1.0))
 
 
+def _eigvals(G):
+    """Eigenvalues (N, 3) of symmetric PSD matrices, descending (Jacobi; round-off negatives sort last)."""
+    return sym_eig3(np.ascontiguousarray(G))[0]
+
+
 def _projected_eig(G, P):
     """Eigenvalues (descending) of P G P for a fixed projector P (3, 3)."""
-    return np.linalg.eigvalsh(P @ G @ P)[..., ::-1]
+    return _eigvals(P @ G @ P)
 
 
 def classify(G, k, baselines_b) -> tuple[np.ndarray, np.ndarray]:
@@ -66,7 +73,7 @@ def classify(G, k, baselines_b) -> tuple[np.ndarray, np.ndarray]:
             return np.full(G.shape[:1], sin_b), np.full(G.shape[:1], 7)
         n = n / np.linalg.norm(n)
         out_of_plane = _ratio_angle(np.einsum("i,...ij,j->...", n, G, n), tr)
-        spread = _ratio_angle(np.linalg.eigvalsh(G)[..., 1], tr)   # second largest eigenvalue
+        spread = _ratio_angle(_eigvals(G)[..., 1], tr)               # second largest eigenvalue
         line = (k > 2) & (spread < out_of_plane)
         margin = np.where(line, spread, out_of_plane)
         code = np.where(margin < DEGENERACY_TOL_RAD, np.where(line, 5, np.where(k <= 2, 4, 6)), 0)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import ValidationInputError
+from .jacobi import sym_eig3
 
 RANK_RTOL = 1e-12
 NULL_COMPONENT_TOL = 1e-10
@@ -36,13 +37,12 @@ def svd(L) -> tuple[np.ndarray, np.ndarray]:
     """Eq. (4) for a symmetric positive semi-definite ``L`` (..., 3, 3): singular values ``sigma`` (..., 3) in
     descending order and the orthogonal ``U`` (..., 3, 3) with ``U[..., i, j]`` the component of state i on
     singular vector j (the layout of the paper's Table 1). Computed by a symmetric eigendecomposition
-    (eigenvalues of a PSD matrix are its singular values; round-off negatives are taken in absolute value)."""
+    (eigenvalues of a PSD matrix are its singular values; round-off negatives are taken in absolute value), by
+    Jacobi rotations (:func:`simkit.validation.jacobi.sym_eig3`)."""
     L = _check_gramian(L)
-    lam, vec = np.linalg.eigh(0.5 * (L + np.swapaxes(L, -1, -2)))
-    order = np.argsort(-np.abs(lam), axis=-1)
-    sigma = np.take_along_axis(np.abs(lam), order, axis=-1)
-    U = np.take_along_axis(vec, order[..., None, :], axis=-1)
-    return sigma, U
+    flat = np.ascontiguousarray(L.reshape(-1, 3, 3))
+    lam, vec = sym_eig3(flat)
+    return np.abs(lam).reshape(L.shape[:-1]), vec.reshape(L.shape)
 
 
 def rank_threshold(sigma, rtol: float = RANK_RTOL, atol: float = 0.0) -> np.ndarray:
