@@ -103,17 +103,24 @@ def _count_inversions(x):
 def c7_pairs(atd, degree) -> tuple[int, int, np.ndarray | None]:
     """C7 over all pairs of epochs of one angle, same satellite count: (``atd``, ``degree``) (N,) with finite
     ATDOP. A pair with different ATDOPs holds when the lower ATDOP has the strictly higher degree. Returns
-    (comparable pairs, held pairs, counter-example index pair or None): the adjacent pair in ATDOP order with
-    the largest degree increase, when any."""
+    (comparable pairs, held pairs, counter-example index pair or None): the violated pair (lower ATDOP first)
+    with the largest degree excess, when any."""
     order = np.lexsort((degree, atd))                       # by ATDOP, ties by ascending degree
     a, d = atd[order], degree[order]
     n = a.size
     _, ties = np.unique(a, return_counts=True)
     comparable = n * (n - 1) // 2 - int((ties * (ties - 1) // 2).sum())
     held = int(_count_inversions(d)) if n > 1 else 0
-    step = (a[1:] > a[:-1]) & (d[1:] >= d[:-1])
+    # worst violation: each epoch against the lowest degree among epochs of strictly lower ATDOP
+    pm = np.minimum.accumulate(d)
+    arg = np.maximum.accumulate(np.where(d == pm, np.arange(n), 0))
+    start = np.unique(a, return_index=True)[1]
+    group_start = start[np.searchsorted(start, np.arange(n), side="right") - 1]
+    has_lower = group_start > 0
+    prev = np.maximum(group_start - 1, 0)
+    excess = np.where(has_lower, d - pm[prev], -np.inf)
     example = None
-    if step.any():
-        i = int(np.argmax(np.where(step, d[1:] - d[:-1], -np.inf)))
-        example = np.array([order[i], order[i + 1]])
+    if n > 1 and excess.max() >= 0:
+        j = int(np.argmax(excess))
+        example = np.array([order[arg[prev[j]]], order[j]])
     return comparable, held, example
