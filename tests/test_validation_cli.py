@@ -57,6 +57,7 @@ def test_file_input_matches_scenario_input(tmp_path):
     (["validate", "xian_static_bds", "--random", "-1"], "--random"),
     (["validate", "missing.h5", "--set", "a=1"], "--set"),
     (["validate", "xian_static_bds", "--weighting", "bogus"], "--weighting"),
+    (["validate", "xian_static_bds", "--systems", "G", *SHORT], "--systems: no satellite"),
 ])
 def test_bad_input_is_one_line(tmp_path, args, expect):
     assert_clean_error(args, tmp_path, expect=expect)

@@ -23,6 +23,8 @@ def add_parser(sub):
     p.add_argument("--report", metavar="DIR", help="write report.md and PNG figures into this folder (created)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario key (scenario input only), e.g. --set scenario.duration_s=3600")
+    p.add_argument("--systems", metavar="LETTERS",
+                   help="only satellites of these systems, comma-separated RINEX letters (e.g. C for BDS)")
     p.add_argument("--weighting", choices=("dd", "identity"), default="dd",
                    help="R: 'dd' equally weighted undifferenced phases (correlated DDs, default) or 'identity'")
     p.add_argument("--random", type=int, default=1, metavar="N",
@@ -38,6 +40,8 @@ def run(args) -> int:
 
     report = _check_outputs(args)
     geo = _geometry(args, geometry)
+    if args.systems:
+        geo = geometry.select_systems(geo, args.systems)
     v = validate(geo, weighting=args.weighting, n_random=args.random, seed=args.seed,
                  progress=not args.no_progress)
     _write(args, v, report)

@@ -6,7 +6,7 @@ the trajectory's reference point, file: antenna 0) and rotated ECEF -> ENU -> bo
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -112,3 +112,16 @@ def from_file(ds) -> Geometry:
     return Geometry(t, int(ds.attrs.get("start_gps_week", 0)), float(ds.attrs.get("start_gps_sow", 0.0)),
                     tuple(ds["gnss/sat_id"][:].tolist()), los, el, vis & np.isfinite(el), arms,
                     f"file {ds.path.name} (scenario {ds.scenario_name})")
+
+
+def select_systems(geo: Geometry, systems: str) -> Geometry:
+    """``geo`` restricted to the satellites whose id starts with one of ``systems`` (e.g. "C" for BDS, "G,C")."""
+    letters = {s.strip().upper() for s in systems.split(",") if s.strip()}
+    keep = np.array([sid[:1].upper() in letters for sid in geo.sat_ids], bool)
+    if not keep.any():
+        found = sorted({sid[:1] for sid in geo.sat_ids})
+        raise ValidationInputError(f"--systems: no satellite of system(s) {systems!r}; the sky has "
+                                   f"{', '.join(found)}")
+    return replace(geo, sat_ids=tuple(np.array(geo.sat_ids)[keep].tolist()), los_b=geo.los_b[:, keep],
+                   elevation=geo.elevation[:, keep], visible=geo.visible[:, keep],
+                   source=f"{geo.source}, systems {','.join(sorted(letters))}")
