@@ -55,6 +55,7 @@ def test_file_input_matches_scenario_input(tmp_path):
     (["validate", "missing.h5"], "missing.h5: no such file"),
     (["validate", "xian_static_bds", "--json", "nodir/v.json"], "does not exist"),
     (["validate", "xian_static_bds", "--random", "-1"], "--random"),
+    (["validate", "xian_static_bds", "--random-stride", "0"], "--random-stride"),
     (["validate", "missing.h5", "--set", "a=1"], "--set"),
     (["validate", "xian_static_bds", "--weighting", "bogus"], "--weighting"),
     (["validate", "xian_static_bds", "--systems", "G", *SHORT], "--systems: no satellite"),

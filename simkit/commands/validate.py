@@ -29,6 +29,8 @@ def add_parser(sub):
                    help="R: 'dd' equally weighted undifferenced phases (correlated DDs, default) or 'identity'")
     p.add_argument("--random", type=int, default=1, metavar="N",
                    help="random satellite orderings per epoch besides highest-elevation-first (default 1)")
+    p.add_argument("--random-stride", type=int, default=10, metavar="N",
+                   help="draw the random orderings at every N-th epoch (default 10; 1 = every epoch)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random subsets (default 0)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
@@ -43,7 +45,7 @@ def run(args) -> int:
     if args.systems:
         geo = geometry.select_systems(geo, args.systems)
     v = validate(geo, weighting=args.weighting, n_random=args.random, seed=args.seed,
-                 progress=not args.no_progress)
+                 random_stride=args.random_stride, progress=not args.no_progress)
     _write(args, v, report)
     claims = v.summary["claims"]
     for name, c in claims.items():
@@ -59,6 +61,8 @@ def _check_outputs(args):
     """Before any work: --random >= 0, the JSON's folder exists, the report folder can be created."""
     if args.random < 0:
         raise ScenarioError("--random", f"found {args.random}; expected a count >= 0")
+    if args.random_stride < 1:
+        raise ScenarioError("--random-stride", f"found {args.random_stride}; expected an epoch step >= 1")
     if args.json:
         folder = Path(args.json).resolve().parent
         if not folder.is_dir():

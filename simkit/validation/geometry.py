@@ -125,3 +125,11 @@ def select_systems(geo: Geometry, systems: str) -> Geometry:
     return replace(geo, sat_ids=tuple(np.array(geo.sat_ids)[keep].tolist()), los_b=geo.los_b[:, keep],
                    elevation=geo.elevation[:, keep], visible=geo.visible[:, keep],
                    source=f"{geo.source}, systems {','.join(sorted(letters))}")
+
+
+def every_nth(geo: Geometry, step: int) -> Geometry:
+    """``geo`` at every ``step``-th epoch (the same object for step 1)."""
+    if step == 1:
+        return geo
+    return replace(geo, t=geo.t[::step], los_b=geo.los_b[::step], elevation=geo.elevation[::step],
+                   visible=geo.visible[::step])

@@ -100,7 +100,10 @@ def gramian_operator(baselines_b, weighting: str = "dd") -> np.ndarray:
 def gramian_from_scatter(G, baselines_b, weighting: str = "dd") -> np.ndarray:
     """L (..., 3, 3) from the line-of-sight scatter ``G`` (..., 3, 3) (see :func:`los_scatter`)."""
     G = np.asarray(G, dtype=float)
-    return (G.reshape(*G.shape[:-2], 9) @ gramian_operator(baselines_b, weighting)).reshape(G.shape)
+    T = gramian_operator(baselines_b, weighting)
+    # (9, 9) @ (9, N) with the long axis last: 4x faster in OpenBLAS than (N, 9) @ (9, 9)
+    L = (T.T @ G.reshape(-1, 9).T).T
+    return np.ascontiguousarray(L).reshape(G.shape)
 
 
 def los_scatter(e_b, weighting: str = "dd") -> np.ndarray:

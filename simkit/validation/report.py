@@ -104,7 +104,8 @@ def _setup(s) -> list[str]:
              f"{s['start_gps']['sow']:g}), {s['epochs']} epochs every {s['interval_s']:g} s",
              f"- satellites: {len(s['satellites'])} in the sky, {s['visible']['min']}-{s['visible']['max']} visible",
              f"- noise model (R): `{s['weighting']}`; subsets: highest elevation first, plus "
-             f"{s['subsets']['random_orderings']} random ordering(s) (seed {s['subsets']['seed']})",
+             f"{s['subsets']['random_orderings']} random ordering(s) every {s['subsets']['random_stride']} epochs "
+             f"(seed {s['subsets']['seed']})",
              f"- tolerances: rank {s['tolerances']['rank_rtol']:g} x sigma_max; degenerate geometry within "
              f"{s['tolerances']['degeneracy_rad']:g} rad"]
     for name, c in s["configurations"].items():
