@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import checks
-from .degeneracy import REASONS, classify, expected_rank
+from .degeneracy import classify, expected_rank
 from .gramian import design_matrix, gramian_from_scatter
 from .observability import RANK_RTOL, atdop_from_svd, observable_degree_from_svd, rank_from_svd, svd
 from .subsets import cumulative_scatter, ordering
@@ -37,8 +37,7 @@ class Group:
 
 
 def _tally(group: Group, claim: str) -> dict:
-    return group.tallies.setdefault(claim, {"checked": 0, "failed": 0, "not_applicable": 0, "degenerate": 0,
-                                            "examples": []})
+    return group.tallies.setdefault(claim, {"checked": 0, "failed": 0, "degenerate": 0, "examples": []})
 
 
 def _plain(v):
@@ -169,7 +168,3 @@ def c7(geo, g: Group, all_visible: bool = False) -> dict:
                     for i in ex]})
     out["examples"] = out["examples"][:MAX_EXAMPLES]
     return out
-
-
-def reason_names() -> dict:
-    return dict(REASONS)
