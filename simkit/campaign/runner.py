@@ -22,11 +22,12 @@ from .records import read_record, record_path, verify, write_json_atomic
 from .task import execute, failed_record
 
 SUMMARY_VERSION = 1
-CONNECT_TIMEOUT_S = 10.0
+CONNECT_TIMEOUT_S = 10.0  # how long --scheduler is tried before the error
 
 
 @contextlib.contextmanager
-def dask_client(workers: int | None = None, scheduler: str | None = None):
+def dask_client(workers: int | None = None, scheduler: str | None = None,
+                connect_timeout_s: float | None = None):
     """A ``distributed.Client``: to ``scheduler`` (``tcp://host:port``), or to a new local cluster of ``workers``
     single-threaded processes (default 2), closed on exit."""
     try:
@@ -35,7 +36,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None):
         raise CampaignInputError("campaign", "needs dask and distributed: pip install 'simkit[campaign]'") from None
     if scheduler is not None:
         try:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+            client = Client(scheduler, timeout=connect_timeout_s or CONNECT_TIMEOUT_S)
         except (OSError, TimeoutError, ValueError) as exc:
             raise CampaignInputError("--scheduler", f"{scheduler}: cannot connect ({exc}); expected the address "
                                      "of a running `dask scheduler`, e.g. tcp://127.0.0.1:8786") from None
@@ -92,14 +93,14 @@ def _bar(total: int, progress: bool):
     return tqdm(total=total, unit="run", desc="campaign", disable=not progress, leave=False)
 
 
-def prepare_dir(out_dir) -> Path:
-    """``DIR/runs`` created (with ``DIR``'s parent required to exist); a clear error when ``DIR`` is a file."""
+def check_dir(out_dir) -> Path:
+    """The campaign directory ``DIR`` (not created here): a clear error when it is a file or its parent is
+    missing."""
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise CampaignInputError("-o", f"{out}: is a file, expected a directory for the campaign")
     if not out.parent.is_dir():
         raise CampaignInputError("-o", f"{out}: the parent folder {out.parent} does not exist")
-    (out / "runs").mkdir(parents=True, exist_ok=True)
     return out
 
 
@@ -120,11 +121,12 @@ def run_campaign(scenario, out_dir, runs: int, grid=(), overrides=(), first_seed
     for name in metrics:
         get(name)
     specs = plan(scenario, runs, grid, first_seed, overrides)
-    out = prepare_dir(out_dir)
+    out = check_dir(out_dir)
     done, todo = triage(specs, out / "runs", metrics)
     records = dict(done)
     if todo:
-        with dask_client(workers, scheduler) as client:
+        with dask_client(workers, scheduler) as client:  # connect before creating anything on disk
+            (out / "runs").mkdir(parents=True, exist_ok=True)
             records.update(_collect(client, todo, out / "runs", metrics, progress))
     summary = _summary(specs, records, scenario, runs, grid, overrides, first_seed, metrics, confidence)
     summary["counts"]["skipped"] = len(done)
