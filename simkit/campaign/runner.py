@@ -50,17 +50,19 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
 
 def triage(specs, run_dir: Path, metric_names) -> tuple[dict, list]:
     """Split the plan into verified records that need nothing ({run_id: record}) and work to submit
-    [(spec, previous record or None)]: previous is a verified record that only lacks some metrics."""
+    [(spec, previous, text)]: previous is a verified record that only lacks some metrics (else None), text the
+    effective scenario the run's file must carry."""
     done, todo = {}, []
     for spec in specs:
         rec = read_record(record_path(run_dir, spec.run_id))
-        if verify(rec, run_dir / f"{spec.run_id}.h5", expected_text(spec), spec.seed) is None:
+        text = expected_text(spec)
+        if verify(rec, run_dir / f"{spec.run_id}.h5", text, spec.seed) is None:
             if all(m in rec.get("metrics", {}) for m in metric_names):
                 done[spec.run_id] = rec
             else:
-                todo.append((spec, rec))
+                todo.append((spec, rec, text))
         else:
-            todo.append((spec, None))
+            todo.append((spec, None, text))
     return done, todo
 
 
@@ -68,8 +70,8 @@ def _collect(client, todo, run_dir: Path, metric_names, progress: bool) -> dict:
     from distributed import as_completed
 
     tag = uuid.uuid4().hex[:8]
-    futures = {client.submit(execute, spec, str(run_dir), tuple(metric_names), prev, pure=False,
-                             key=f"simkit-run-{spec.run_id}-{tag}"): spec for spec, prev in todo}
+    futures = {client.submit(execute, spec, str(run_dir), tuple(metric_names), prev, text, pure=False,
+                             key=f"simkit-run-{spec.run_id}-{tag}"): spec for spec, prev, text in todo}
     records = {}
     bar = _bar(len(futures), progress)
     try:
@@ -95,8 +97,8 @@ def _bar(total: int, progress: bool):
 
 def check_dir(out_dir) -> Path:
     """The campaign directory ``DIR`` (not created here): a clear error when it is a file or its parent is
-    missing."""
-    out = Path(out_dir)
+    missing. Absolute, since workers run in other folders (or on other machines sharing the file system)."""
+    out = Path(out_dir).absolute()
     if out.exists() and not out.is_dir():
         raise CampaignInputError("-o", f"{out}: is a file, expected a directory for the campaign")
     if not out.parent.is_dir():
