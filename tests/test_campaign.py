@@ -14,8 +14,6 @@ from simkit.campaign import CampaignInputError, mean_interval, parse_grid, plan,
 from simkit.campaign.ambiguity_metric import ambiguity, dd_observations
 from simkit.campaign.plan import grid_points, split_values
 
-SHORT = ["scenario.duration_s=20", "trajectory.segment[0].duration_s=20"]
-
 
 def test_wilson_interval_equals_scipy_binomtest():
     for n in (1, 7, 30, 263, 1000):

@@ -29,7 +29,7 @@ CONNECT_TIMEOUT_S = 10.0  # how long --scheduler is tried before the error
 def dask_client(workers: int | None = None, scheduler: str | None = None,
                 connect_timeout_s: float | None = None):
     """A ``distributed.Client``: to ``scheduler`` (``tcp://host:port``), or to a new local cluster of ``workers``
-    single-threaded processes (default 2), closed on exit."""
+    single-threaded processes (default 2) listening on loopback only (random ports), closed on exit."""
     try:
         from distributed import Client, LocalCluster
     except ImportError:
@@ -43,8 +43,9 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         with client:
             yield client
         return
-    with LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+    with LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR) as cluster, \
+            Client(cluster) as client:
         yield client
 
 
