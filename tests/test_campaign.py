@@ -110,3 +110,27 @@ def test_campaign_bad_input_is_one_clean_line(tmp_path, monkeypatch):
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 0.5)
     assert_clean_error(base + ["--runs", "1", "--scheduler", "tcp://127.0.0.1:9"], tmp_path,
                        expect="--scheduler: tcp://127.0.0.1:9: cannot connect")
+
+
+def test_task_adds_missing_metrics_without_rerunning_and_keeps_a_completed_run(tmp_path):
+    from simkit.campaign.plan import expected_text
+    from simkit.campaign.runner import triage
+    from simkit.campaign.task import execute
+
+    over = ("scenario.duration_s=5", "trajectory.segment[0].duration_s=5")
+    spec = plan("xian_static_bds", 1, overrides=over)[0]
+    first = execute(spec, str(tmp_path), ("imu_errors",))
+    h5 = tmp_path / f"{spec.run_id}.h5"
+    stamp = h5.stat().st_mtime_ns
+    done, todo = triage([spec], tmp_path, ("imu_errors",))
+    assert list(done) == [spec.run_id] and not todo
+    done, todo = triage([spec], tmp_path, ("imu_errors", "gnss_errors"))
+    assert not done and todo[0][1]["sha256"] == first["sha256"]
+    second = execute(spec, str(tmp_path), ("imu_errors", "gnss_errors"), todo[0][1])
+    assert set(second["metrics"]) == {"imu_errors", "gnss_errors"} and second["sha256"] == first["sha256"]
+    again = execute(spec, str(tmp_path), ("imu_errors", "gnss_errors"), None, expected_text(spec))
+    assert again == second and h5.stat().st_mtime_ns == stamp  # a re-executed task leaves a finished run alone
+    with simkit.open(h5) as ds:  # another seed behind the same name is not "complete"
+        assert ds.attrs["seed"] == spec.seed
+    assert triage([spec.__class__(spec.run_id, spec.scenario, 7, spec.overrides, 0)], tmp_path,
+                  ("imu_errors",))[1][0][1] is None
