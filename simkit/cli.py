@@ -15,7 +15,7 @@ import sys
 from .errors import SimkitError
 from .version import __version__
 
-COMMANDS = ("run", "inspect", "allan", "sky", "rinex", "validate")
+COMMANDS = ("run", "inspect", "allan", "sky", "rinex", "validate", "campaign")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -1,0 +1,63 @@
+"""What a Dask worker does for one run: simulate it, compute its metrics, and write its record.
+
+The HDF5 file is written atomically by :func:`simkit.pipeline.run` (a hidden temporary renamed when complete;
+the temporary of a killed worker is removed by the next run to the same name), then the record is written
+atomically, so a run is either complete on disk or absent, never half-written.
+"""
+from __future__ import annotations
+
+import os
+import socket
+import time
+from pathlib import Path
+
+from ..io import open_dataset
+from ..pipeline import run as simulate
+from .metrics import evaluate
+from .plan import RunSpec
+from .records import RECORD_VERSION, file_digest, read_record, record_path, verify, write_json_atomic
+
+
+def base_record(spec: RunSpec) -> dict:
+    """The fields every record of ``spec`` carries."""
+    return {"record_version": RECORD_VERSION, "run_id": spec.run_id, "seed": spec.seed, "point": spec.point,
+            "overrides": list(spec.overrides), "file": f"{spec.run_id}.h5"}
+
+
+def execute(spec: RunSpec, run_dir: str, metric_names: tuple[str, ...], previous: dict | None = None,
+            text: str | None = None) -> dict:
+    """Run ``spec`` into ``run_dir/<run_id>.h5`` and evaluate ``metric_names`` on it; returns the record (also
+    written to ``run_dir/<run_id>.json``). With ``previous`` (the verified record of a completed run) the file is
+    kept and only the metrics it lacks are computed. With ``text`` (the expected effective scenario) a run found
+    complete on disk is returned as it is: Dask recomputes a task whose result died with its worker before the
+    client fetched it, and that must not rewrite a finished run. Any exception becomes a "failed" record."""
+    run_dir = Path(run_dir)
+    h5 = run_dir / f"{spec.run_id}.h5"
+    if previous is None and text is not None:
+        found = read_record(record_path(run_dir, spec.run_id))
+        if verify(found, h5, text, spec.seed) is None and all(m in found.get("metrics", {}) for m in metric_names):
+            return found
+    t0 = time.perf_counter()
+    rec = base_record(spec)
+    try:
+        if previous is None:
+            simulate(spec.scenario, out=h5, seed=spec.seed, overrides=list(spec.overrides))
+            metrics = {}
+        else:
+            metrics = dict(previous.get("metrics", {}))
+        with open_dataset(h5) as ds:
+            metrics.update(evaluate(ds, [m for m in metric_names if m not in metrics]))
+        rec.update(status="ok", sha256=previous["sha256"] if previous else file_digest(h5), metrics=metrics,
+                   elapsed_s=(previous or {}).get("elapsed_s", time.perf_counter() - t0))
+    except Exception as exc:  # recorded, never fatal to the campaign
+        rec.update(status="failed", error=f"{type(exc).__name__}: {exc}", elapsed_s=time.perf_counter() - t0)
+    rec["worker"] = f"{socket.gethostname()}:{os.getpid()}"
+    write_json_atomic(record_path(run_dir, spec.run_id), rec)
+    return rec
+
+
+def failed_record(spec: RunSpec, error: BaseException) -> dict:
+    """The record of a run whose task never returned (its worker died too often, the task was lost)."""
+    rec = base_record(spec)
+    rec.update(status="failed", error=f"{type(error).__name__}: {error}", elapsed_s=None, worker=None)
+    return rec
