@@ -134,3 +134,31 @@ def test_task_adds_missing_metrics_without_rerunning_and_keeps_a_completed_run(t
         assert ds.attrs["seed"] == spec.seed
     assert triage([spec.__class__(spec.run_id, spec.scenario, 7, spec.overrides, 0)], tmp_path,
                   ("imu_errors",))[1][0][1] is None
+
+
+def test_index_file_holds_the_run_table_and_virtual_datasets_over_the_runs(tmp_path):
+    import h5py
+
+    import simkit
+    from simkit.campaign.index import write_index
+
+    (tmp_path / "runs").mkdir()
+    rows = []
+    for seed in (3, 4):
+        simkit.run("quickstart", out=tmp_path / "runs" / f"s{seed}.h5", seed=seed,
+                   overrides=["scenario.duration_s=2"])
+        rows.append({"run_id": f"s{seed}", "status": "ok", "file": f"runs/s{seed}.h5", "sha256": "x", "seed": seed,
+                     "point": 0, "elapsed_s": 1.0, "metrics": {"gnss_errors.rms": 0.1 * seed}})
+    rows.append({"run_id": "s5", "status": "failed", "file": "runs/s5.h5", "sha256": None, "seed": 5, "point": 0,
+                 "elapsed_s": None, "metrics": {}})
+    stacked = write_index(tmp_path, rows)
+    assert "imu/gyro" in stacked and "gnss/obs/L1C/carrier" in stacked
+    moved = tmp_path.parent / (tmp_path.name + "_moved")
+    tmp_path.rename(moved)   # relative sources: the folder can move
+    with h5py.File(moved / "index.h5", "r") as f:
+        assert [s.decode() for s in f["campaign/runs/status"][:]] == ["ok", "ok", "failed"]
+        np.testing.assert_allclose(f["campaign/runs/gnss_errors.rms"][:2], [0.3, 0.4])
+        assert np.isnan(f["campaign/runs/gnss_errors.rms"][2])
+        gyro = f["campaign/virtual/imu.gyro"][...]
+        with h5py.File(moved / "runs" / "s4.h5", "r") as run:
+            np.testing.assert_array_equal(gyro[1], run["imu/gyro"][...])

@@ -18,6 +18,7 @@ from .aggregate import run_table, summarise
 from .errors import CampaignInputError
 from .metrics import DEFAULT_METRICS, get
 from .plan import RunSpec, expected_text, parse_grid, plan
+from .index import write_index
 from .records import read_record, record_path, verify, write_json_atomic
 from .task import execute, failed_record
 
@@ -135,6 +136,7 @@ def run_campaign(scenario, out_dir, runs: int, grid=(), overrides=(), first_seed
     summary["counts"]["skipped"] = len(done)
     summary["elapsed_s"] = time.perf_counter() - t0
     summary["cluster"] = scheduler or f"local, {workers or 2} worker processes"
+    summary["index"] = {"file": "index.h5", "stacked": len(write_index(out, summary["runs"]))}
     write_json_atomic(out / "summary.json", summary)
     return summary
 

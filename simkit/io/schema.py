@@ -5,8 +5,9 @@ a path, dtype or shape that is not declared here and takes the units from here; 
 the RINEX exporter, the ``/solutions`` writer and the README table (``python -m simkit.io.schema``) follow it.
 
 Shape symbols: N truth/IMU samples, M GNSS epochs, A antennas, S satellites, G signals, K solution epochs,
-X solution states. Placeholders in paths: ``<signal>`` a signal name (``L1C``, ``B1I``, ...), ``<term>`` an IMU
-error term (``gyro_bias``, ``accel_white``, ...), ``<name>`` a solution name, ``<extra>`` a filter's extra output.
+X solution states, R campaign runs. Placeholders in paths: ``<signal>`` a signal name (``L1C``, ``B1I``, ...),
+``<term>`` an IMU error term (``gyro_bias``, ``accel_white``, ...), ``<name>`` a solution name, ``<extra>`` a
+filter's extra output.
 """
 from __future__ import annotations
 
@@ -132,7 +133,14 @@ _SOLUTIONS = [
        "filter-specific outputs (biases, lever arm, gamma, ambiguities, ratio, ...)"),
 ]
 
-SCHEMA: tuple[Field, ...] = tuple(_TRUTH + _IMU + _GNSS + _SOLUTIONS)
+_CAMPAIGN = [
+    _f("campaign/runs/<column>", "any", ("R",), "see attribute", "", "campaign",
+       "campaign index (DIR/index.h5): one column of the per-run table (run_id, seed, status, metrics, ...)"),
+    _f("campaign/virtual/<path>", "any", ("R", "..."), "as the run files", "", "campaign",
+       "campaign index: virtual dataset stacking one dataset of every completed run file (/ written as .)"),
+]
+
+SCHEMA: tuple[Field, ...] = tuple(_TRUTH + _IMU + _GNSS + _SOLUTIONS + _CAMPAIGN)
 
 GROUP_ATTRS = {
     "truth": {"rate_hz": "trajectory.rate_hz"},

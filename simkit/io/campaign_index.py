@@ -1,0 +1,63 @@
+"""The campaign index file ``DIR/index.h5``: the per-run summary table and virtual datasets over the run files.
+
+``/campaign/runs/<column>`` (R,): one column of the per-run table (NaN where a run lacks a metric);
+``/campaign/virtual/<path with / as .>`` (R, ...): an HDF5 virtual dataset stacking one dataset of every completed
+run file (relative source paths, so the folder can move), made only for datasets of one shape and dtype in every
+run. Written under a temporary name and renamed when complete.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from . import schema
+from .schema import SCHEMA_VERSION
+
+
+def _column(values) -> np.ndarray:
+    if all(isinstance(v, str) for v in values):
+        return np.array(values, dtype=h5py.string_dtype())
+    return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+
+def _common_shapes(run_files, paths) -> dict:
+    """path -> (shape, dtype str) for the paths that have one shape and dtype in every file."""
+    common = None
+    for fn in run_files:
+        with h5py.File(fn, "r") as f:
+            here = {p: (f[p].shape, f[p].dtype.str) for p in paths
+                    if isinstance(f.get(p), h5py.Dataset) and h5py.check_string_dtype(f[p].dtype) is None}
+        common = here if common is None else {p: v for p, v in common.items() if here.get(p) == v}
+    return common or {}
+
+
+def write_campaign_index(path, columns: dict[str, list], run_files: list, stack=()) -> list[str]:
+    """Write the index to ``path``: ``columns`` name -> R values (str, or numbers/None); ``run_files`` the
+    completed run files and ``stack`` the dataset paths to stack over them. Returns the stacked paths."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    stacked = []
+    try:
+        with h5py.File(tmp, "w") as f:
+            f.attrs["schema_version"] = SCHEMA_VERSION
+            f.attrs["kind"] = "campaign_index"
+            for name, values in columns.items():
+                data = _column(list(values))
+                spec = schema.check(f"campaign/runs/{name}", data.dtype if data.dtype.kind != "O" else "U1",
+                                    data.shape)
+                f.create_dataset(f"campaign/runs/{name}", data=data).attrs["units"] = spec.units
+            for p, (shape, dtype) in _common_shapes(run_files, stack).items():
+                layout = h5py.VirtualLayout(shape=(len(run_files),) + shape, dtype=np.dtype(dtype))
+                for i, fn in enumerate(run_files):
+                    layout[i] = h5py.VirtualSource(os.path.relpath(fn, path.parent), p, shape=shape)
+                name = f"campaign/virtual/{p.replace('/', '.')}"
+                schema.check(name, np.dtype(dtype), (len(run_files),) + shape)
+                f.create_virtual_dataset(name, layout, fillvalue=None)
+                stacked.append(p)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return stacked
