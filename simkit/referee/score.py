@@ -16,7 +16,8 @@ from .truth import Truth
 class Score:
     """The result of :func:`score`: ``errors`` (per epoch); ``statistics`` {quantity: {stat: value}} in the units
     of ``stats.UNIT_OF``; ``convergence`` {quantity: {threshold, time_s}}; ``nees`` / ``nis`` (dicts with
-    ``series``) or None; ``checks`` [{name, value, limit, passed}]; ``meta`` (epochs scored and dropped)."""
+    ``series``) or None; ``checks`` [{name, value, limit, passed}]; ``meta`` (epochs scored and dropped); ``sigmas`` {covariance
+    state name: (K,) standard deviation at the scored epochs, SI}."""
 
     errors: Errors
     statistics: dict
@@ -25,6 +26,7 @@ class Score:
     nis: dict | None
     checks: list = field(default_factory=list)
     meta: dict = field(default_factory=dict)
+    sigmas: dict = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
@@ -53,7 +55,11 @@ def score(truth: Truth, sol: Solution, spec: Spec | None = None, where: str = "e
     nis = stats.nis(err, sol.extras, confidence)
     meta = {"epochs_scored": int(err.t.size), "epochs_outside_truth": int(np.size(sol.t) - err.t.size),
             "t_first_s": float(err.t[0]), "t_last_s": float(err.t[-1])}
-    return Score(err, table, conv, nees, nis, _checks(spec, table, conv, nees, nis), meta)
+    sigmas = {}
+    if sol.cov is not None:
+        diag = np.einsum("kii->ki", np.asarray(sol.cov, dtype=float)[err.index])
+        sigmas = {name: np.sqrt(diag[:, j]) for j, name in enumerate(sol.state_names)}
+    return Score(err, table, conv, nees, nis, _checks(spec, table, conv, nees, nis), meta, sigmas)
 
 
 def _check(name, value, limit, passed):
