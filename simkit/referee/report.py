@@ -82,8 +82,9 @@ def to_markdown(sc: Score, label: str = "", truth: str = "") -> str:
     for q, row in sc.statistics.items():
         out.append(f"| {q} | {UNIT_TEXT[UNIT_OF[q]]} | " + " | ".join(_fmt(row[s]) for s in STATS) + " |")
     out += ["", "## Convergence", ""]
-    out += [f"- {q}: |error| <= {c['threshold']:g} {UNIT_TEXT[UNIT_OF[q]]} from "
-            + (f"{c['time_s']:.2f} s after the first epoch" if c["time_s"] is not None else "never (not converged)")
+    out += [f"- {q}: |error| <= {c['threshold']:g} {UNIT_TEXT[UNIT_OF[q]]} "
+            + (f"for good from {c['time_s']:.2f} s after the first epoch" if c["time_s"] is not None
+               else "not reached for good (still exceeded at the last epoch)")
             for q, c in sc.convergence.items()]
     out += ["", "## Consistency", "", *_consistency_lines(sc), "", "## Checks", ""]
     out += [f"- {'PASS' if c['passed'] else 'FAIL'}: {c['name']} (value {_fmt(c['value'])})" for c in sc.checks]
