@@ -26,7 +26,7 @@ def pytest_addoption(parser):
 @pytest.fixture
 def simkit_regress(request, tmp_path):
     """``check(scenario, golden_path, duration_s=5.0, overrides=())``: compare or (first run / update) write."""
-    update = request.config.getoption("--simkit-update-golden")
+    update = request.config.getoption("--simkit-update-golden", default=False)
 
     def check(scenario, golden_path, duration_s: float = regress.DEFAULT_SHORT_S, overrides=()):
         golden_path = Path(golden_path)
