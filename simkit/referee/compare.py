@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from .. import frames
 from ..solution import Solution
+from . import quat
 from .errors import RefereeInputError
 from .truth import Truth, overlap, truth_at
 
@@ -83,5 +84,5 @@ def compare(truth: Truth, sol: Solution, where: str = "estimate") -> Errors:
     if rot is not None:
         rot, rot_true = rot[index], Rotation.from_quat(ref.quat_nb)
         eul = wrap(frames.euler_from_attitude(rot) - frames.euler_from_attitude(rot_true))
-        att = (rot * rot_true.inv()).as_rotvec()
+        att = quat.as_rotvec(quat.mul(rot.as_quat(), quat.conj(ref.quat_nb)))
     return Errors(t, index, pos, vel, eul, att)

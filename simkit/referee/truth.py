@@ -10,10 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .. import frames
 from ..io import open_dataset
+from . import quat
 from .errors import RefereeInputError
 
 
@@ -64,6 +64,5 @@ def truth_at(truth: Truth, t: np.ndarray) -> Truth:
     pos = h00 * p0 + h10 * h[:, None] * v0 + h01 * p1 + h11 * h[:, None] * v1
     vel = (1 - s) * truth.vel_enu[i] + s * truth.vel_enu[i + 1]
     q0, q1 = truth.quat_nb[i], truth.quat_nb[i + 1]
-    rel = (Rotation.from_quat(q0).inv() * Rotation.from_quat(q1)).as_rotvec()
-    quat = (Rotation.from_quat(q0) * Rotation.from_rotvec(rel * s)).as_quat()
-    return Truth(t, pos, vel, quat)
+    rel = quat.as_rotvec(quat.mul(quat.conj(q0), q1))          # slerp: q0 exp(s log(q0^-1 q1))
+    return Truth(t, pos, vel, quat.mul(q0, quat.from_rotvec(rel * s)))
