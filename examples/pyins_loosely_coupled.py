@@ -11,7 +11,7 @@ implements simkit's plugin interface (:mod:`simkit.referee.plugin`):
 - ``solution`` runs pyins' extended (feedback) Kalman filter ``pyins.filters.run_feedback_filter`` over the
   stored IMU data with the fixes as ``pyins.measurements.Position`` (with pyins' own lever-arm handling), and
   converts its NED output and standard deviations to simkit's conventions with
-  :func:`simkit.referee.solution_from_ned`.
+  :func:`simkit.referee.solution_from_ned`; pyins' standardised position innovations give the NIS (3 dof).
 
 Run: ``python examples/pyins_loosely_coupled.py airborne_stim300.h5 [--duration 300] [--report DIR]``
 (simulate the file first with ``simkit run airborne_stim300``).
@@ -19,6 +19,7 @@ Run: ``python examples/pyins_loosely_coupled.py airborne_stim300.h5 [--duration 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 
@@ -115,7 +116,10 @@ class PyinsLooselyCoupled:
             time_step=self.time_step_s)
         sd = result.trajectory_sd
         traj = result.trajectory.loc[sd.index]
-        return referee.solution_from_ned(
+        # pyins returns standardised innovations (identity covariance): their squared norm is the NIS
+        nu = result.innovations["Position"]
+        nis = pd.Series((nu.values ** 2).sum(axis=1), index=nu.index).reindex(sd.index)
+        sol = referee.solution_from_ned(
             traj.index.values, np.radians(traj.lat.values), np.radians(traj.lon.values), traj.alt.values,
             vel_ned=traj[["VN", "VE", "VD"]].values, roll=np.radians(traj.roll.values),
             pitch=np.radians(traj.pitch.values), heading=np.radians(traj.heading.values),
@@ -123,6 +127,9 @@ class PyinsLooselyCoupled:
             sd_rph=np.radians(sd[["roll", "pitch", "heading"]].values),
             config={"filter": "pyins.filters.run_feedback_filter", "position_sd_m": self.position_sd_m,
                     "signal": self.signal, "fixes": len(self.fixes)})
+        dof = np.where(np.isfinite(nis.values), 3.0, 0.0)
+        return dataclasses.replace(sol, extras={"nis": nis.values, "nis_dof": dof},
+                                   extra_units={"nis": "1", "nis_dof": "1"})
 
 
 def main(argv=None) -> int:

@@ -72,3 +72,4 @@ def test_pyins_loosely_coupled_end_to_end(air):
     assert sc.statistics["heading"]["rms"] < 1.0 and sc.statistics["roll"]["rms"] < 1.0
     assert sc.nees["states"] == ["pos_n", "pos_e", "pos_d", "vel_n", "vel_e", "vel_d", "roll", "pitch", "heading"]
     assert res.timing["solution_s"] > 0 and res.solution.config["fixes"] == 41
+    assert sc.nis["epochs"] == 40 and sc.nis["dof_mean"] == 3.0          # pyins' standardised innovations
