@@ -36,14 +36,20 @@ def work(tmp_path_factory):
     return d
 
 
-def test_score_h5_solution_with_json_and_report(work):
-    out = run_cli(["score", "q.h5", "q.h5", "--spec", "pass.toml", "--json", "s.json", "--report", "rep"], work)
+def test_score_h5_solution_with_json(work):
+    out = run_cli(["score", "q.h5", "q.h5", "--spec", "pass.toml", "--json", "s.json"], work)
     assert out.returncode == 0, out.stderr
     assert "| position_3d | m |" in out.stdout and "**Verdict: PASS**" in out.stdout
     payload = json.loads((work / "s.json").read_text())
     assert payload["estimate"] == "q.h5:/solutions/kf"
     assert payload["statistics"]["position_3d"]["max"] == pytest.approx(0.5, abs=1e-6)
     assert payload["nees"]["mean"] == pytest.approx(25.0, rel=1e-6)       # (0.5 m / 0.1 m)^2
+
+
+@pytest.mark.slow   # four figures: about 4 s of matplotlib rendering
+def test_score_report_writes_markdown_and_error_plots(work):
+    out = run_cli(["score", "q.h5", "q.h5", "--report", "rep"], work)
+    assert out.returncode == 0, out.stderr
     pngs = sorted(p.name for p in (work / "rep").glob("*.png"))
     assert pngs == ["consistency.png", "errors_attitude.png", "errors_position.png", "errors_velocity.png"]
     assert "![errors_position](errors_position.png)" in (work / "rep" / "report.md").read_text()

@@ -40,11 +40,11 @@ def test_pytest_fixture_writes_then_checks_a_users_scenario(simkit_regress, tmp_
 
     scenario.write_text(resolve("quickstart").read_text())
     golden = tmp_path / "golden" / "mine.json"
-    assert simkit_regress(scenario, golden, duration_s=2.0) == []
-    assert json.loads(golden.read_text())["mine"]["duration_s"] == 2.0
-    assert simkit_regress(scenario, golden, duration_s=2.0) == []
+    assert simkit_regress(scenario, golden, duration_s=1.0) == []
+    assert json.loads(golden.read_text())["mine"]["duration_s"] == 1.0
+    assert simkit_regress(scenario, golden, duration_s=1.0) == []
     with pytest.raises(pytest.fail.Exception, match=r"mine: imu/errors/accel_white.std\[x\] drifted"):
-        simkit_regress(scenario, golden, duration_s=2.0, overrides=["imu.accel.vrw_m_per_s_per_sqrt_h=0.5"])
+        simkit_regress(scenario, golden, duration_s=1.0, overrides=["imu.accel.vrw_m_per_s_per_sqrt_h=0.5"])
 
 
 def test_regress_bad_input(tmp_path):
