@@ -89,7 +89,8 @@ class PyinsLooselyCoupled:
             lla = frames.ecef_to_lla(x[:3])
             self.fixes.append((gnss.t, np.degrees(lla[0]), np.degrees(lla[1]), lla[2]))
 
-    def _initial_pva(self):
+    def initial_pva(self, t0):
+        """pyins' initial position-velocity-attitude (degrees, NED, FRD) at time ``t0`` from ``start``'s truth."""
         i = self.init
         lla = frames.ecef_to_lla(i.pos_ecef)
         ned = frames.enu_to_ned(i.vel_enu)
@@ -97,7 +98,7 @@ class PyinsLooselyCoupled:
         roll_pitch_heading = rph.as_euler("ZYX", degrees=True)[::-1]
         values = [np.degrees(lla[0]), np.degrees(lla[1]), lla[2], *ned, *roll_pitch_heading]
         return pd.Series(values, index=["lat", "lon", "alt", "VN", "VE", "VD", "roll", "pitch", "heading"],
-                         name=self.imu[0][0])
+                         name=t0)
 
     def solution(self):
         data = np.array(self.imu)
@@ -109,7 +110,7 @@ class PyinsLooselyCoupled:
                              columns=["lat", "lon", "alt"])
         lever_frd = frames.enu_to_ned(self.init.lever_arm_b[0])
         result = filters.run_feedback_filter(
-            self._initial_pva(), position_sd=1.0, velocity_sd=0.1, level_sd=0.05, azimuth_sd=0.2,
+            self.initial_pva(data[0, 0]), position_sd=1.0, velocity_sd=0.1, level_sd=0.05, azimuth_sd=0.2,
             increments=increments, gyro_model=inertial_sensor.EstimationModel(**self.gyro),
             accel_model=inertial_sensor.EstimationModel(**self.accel),
             measurements=[measurements.Position(fixes, self.position_sd_m, lever_frd)],

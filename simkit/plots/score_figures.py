@@ -48,7 +48,7 @@ def _chi_figure(plt, sc, label):
     tests = [(k, r) for k, r in (("NEES", sc.nees), ("NIS", sc.nis)) if r is not None]
     if not tests:
         return None
-    fig, axes = plt.subplots(len(tests), 1, figsize=(8, 3 * len(tests)), squeeze=False)
+    fig, axes = plt.subplots(len(tests), 1, figsize=(8, 3 * len(tests)), squeeze=False, layout="constrained")
     for ax, (key, r) in zip(axes[:, 0], tests):
         ax.semilogy(sc.errors.t, r["series"], ".", ms=2, label=key)
         lo, hi = r["epoch_bounds"]
