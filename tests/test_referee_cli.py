@@ -26,6 +26,10 @@ def work(tmp_path_factory):
                                       state_names=("pos_e", "pos_n", "pos_u")))
     (d / "est.csv").write_text("t_s,x_ecef_m,y_ecef_m,z_ecef_m\n" + "".join(
         f"{float(t)!r},{float(p[0])!r},{float(p[1])!r},{float(p[2]) + 0.5!r}\n" for t, p in zip(truth.t[k], truth.pos_ecef[k])))
+    week, sow = referee.file_start(h5)
+    (d / "gpst.csv").write_text("gps_week,gps_sow,x_ecef_m,y_ecef_m,z_ecef_m\n" + "".join(
+        f"{week},{sow + float(t)!r},{float(p[0])!r},{float(p[1])!r},{float(p[2])!r}\n"
+        for t, p in zip(truth.t[k], truth.pos_ecef[k])))
     (d / "pass.toml").write_text("[limits]\nposition_3d = { max_m = 1.0 }\n")
     (d / "strict.toml").write_text("[limits]\nposition_3d = { rms_m = 0.1 }\n[consistency]\n"
                                    "nees_min_fraction_inside = 0.9\n")
@@ -60,6 +64,13 @@ def test_score_csv_and_a_failing_spec_exits_1(work):
     assert out.returncode == 1
     assert "FAIL: position_3d.rms_m <= 0.1 (value 0.5)" in out.stdout
     assert "FAIL: NEES inside its 95% chi-square bounds at >= 90% of epochs (value -)" in out.stdout
+
+
+def test_csv_in_gps_time_is_aligned_by_the_file_start(work):
+    out = run_cli(["score", "q.h5", "gpst.csv", "--json", "g.json"], work)
+    assert out.returncode == 0, out.stderr
+    payload = json.loads((work / "g.json").read_text())
+    assert payload["meta"]["epochs_scored"] == 81 and payload["statistics"]["position_3d"]["max"] < 1e-6
 
 
 @pytest.mark.parametrize("args, expect", [

@@ -113,7 +113,7 @@ def _observations(plt, ds):
     if not signals or f"gnss/truth/{signals[0]}/noise_code" not in ds:
         return None
     t = ds["gnss/t"][:]
-    fig, axes = plt.subplots(len(signals), 2, figsize=(11, 3.2 * len(signals)), squeeze=False)
+    fig, axes = plt.subplots(len(signals), 2, figsize=(11, 3.2 * len(signals)), squeeze=False, layout="constrained")
     for row, sig in zip(axes, signals):
         for ax, kind in zip(row, ("code", "carrier")):
             err = ds[f"gnss/truth/{sig}/noise_{kind}"][:, 0] + ds[f"gnss/truth/{sig}/multipath_{kind}"][:, 0]
