@@ -212,3 +212,24 @@ def test_bad_spec_names_the_key(data, expect):
     with pytest.raises(referee.RefereeInputError, match=None) as info:
         referee.parse_spec(data, "pass.toml")
     assert str(info.value).startswith("pass.toml: ") and expect in str(info.value)
+
+
+def test_csv_full_covariance_columns_give_the_same_nees_as_the_solution(h5, truth, tmp_path):
+    """A correlated 2x2 horizontal covariance as cov_<a>__<b> columns (NED names) against the same covariance
+    stored in ENU order: the NEES is a property of the error, not of the state order or the frame names."""
+    sol, _, _ = _perturbed(truth, step=20, pos_sd=0.3, seed=8)
+    p_enu = np.array([[0.09, 0.03], [0.03, 0.16]])          # (east, north)
+    cov = np.broadcast_to(p_enu, (len(sol.t), 2, 2)).copy()
+    ref = referee.score(truth, Solution(t=sol.t, pos_ecef=sol.pos_ecef, cov=cov, state_names=("pos_e", "pos_n")))
+    x, y, z = sol.pos_ecef.T
+    rows = "".join(f"{float(t)!r},{float(a)!r},{float(b)!r},{float(c)!r},0.16,0.09,0.03\n"
+                   for t, a, b, c in zip(sol.t, x, y, z))
+    csv = tmp_path / "cov.csv"
+    csv.write_text("t_s,x_ecef_m,y_ecef_m,z_ecef_m,cov_pos_n__pos_n,cov_pos_e__pos_e,cov_pos_n__pos_e\n" + rows)
+    got = referee.score(truth, referee.read_csv(csv))
+    assert got.nees["states"] == ["pos_n", "pos_e"]
+    np.testing.assert_allclose(got.nees["series"], ref.nees["series"], rtol=1e-9)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t_s,x_ecef_m,y_ecef_m,z_ecef_m,cov_pos_x__pos_n\n0,1,2,3,4\n")
+    with pytest.raises(referee.RefereeInputError, match=r"column cov_pos_x__pos_n: expected cov_<a>__<b>"):
+        referee.read_csv(bad)

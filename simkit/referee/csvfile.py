@@ -8,6 +8,7 @@ comments. Column names carry frame and unit; their order is free.
 | velocity | ``vel_e_m_per_s, vel_n_m_per_s, vel_u_m_per_s`` (ENU) or ``vel_n_m_per_s, vel_e_m_per_s, vel_d_m_per_s`` (NED) |
 | attitude | ``roll_deg, pitch_deg, heading_deg`` (or ``_rad``; the same numbers in ENU/RFU and NED/FRD) or quaternion ``q_enu_w, q_enu_x, q_enu_y, q_enu_z`` (body RFU->ENU) or ``q_ned_w, ..., q_ned_z`` (body FRD->NED) |
 | standard deviations (optional) | ``sd_e_m, sd_n_m, sd_u_m`` / ``sd_d_m``; ``sd_vel_e_m_per_s`` ... ``sd_vel_d_m_per_s``; ``sd_roll_deg, sd_pitch_deg, sd_heading_deg`` (or ``_rad``) |
+| or a covariance (optional) | ``cov_<a>__<b>`` for covariance state names a, b (``pos_n``, ``vel_d``, ``att_e``, ``heading``, ... see ``compare.STATE_SERIES``), SI units (m^2, m^2/s^2, rad^2, m rad, ...); one of each pair is enough; missing pairs are 0 |
 
 The standard deviations give a diagonal covariance (states ``pos_e`` ... ``heading``) for the NEES test.
 """
@@ -92,10 +93,32 @@ def _attitude(cols, path):
     return None, quat_to_simkit(q, {"enu": "enu-rfu", "ned": "ned-frd"}[frame], "wxyz", f"{path}: q_{frame}_*")
 
 
-def _covariance(cols):
-    names = [state for col, state in SD_COLUMNS.items() if col in cols]
-    if not names:
+def _full_covariance(cols, path):
+    """``cov_<a>__<b>`` columns as (K, X, X) in the order the states first appear, or (None, ())."""
+    from .compare import STATE_SERIES
+
+    pairs = [(c, *c[4:].split("__")) for c in cols if c.startswith("cov_")]
+    for col, *names in pairs:
+        if len(names) != 2 or any(n not in STATE_SERIES for n in names):
+            raise RefereeInputError(path, f"column {col}: expected cov_<a>__<b> with a, b among "
+                                          f"{', '.join(STATE_SERIES)}")
+    states = list(dict.fromkeys(n for _, a, b in pairs for n in (a, b)))
+    if not states:
         return None, ()
+    cov = np.zeros((len(next(iter(cols.values()))), len(states), len(states)))
+    for col, a, b in pairs:
+        i, j = states.index(a), states.index(b)
+        cov[:, i, j] = cov[:, j, i] = cols[col]
+    return cov, tuple(states)
+
+
+def _covariance(cols, path):
+    names = [state for col, state in SD_COLUMNS.items() if col in cols]
+    full = _full_covariance(cols, path)
+    if full[0] is not None and names:
+        raise RefereeInputError(path, "give either sd_* columns or cov_* columns, not both")
+    if not names:
+        return full
     scale = [(_DEG if col.endswith("_deg") else 1.0) for col in SD_COLUMNS if col in cols]
     var = (np.stack([cols[c] for c in SD_COLUMNS if c in cols], axis=-1) * scale) ** 2
     return var[:, :, None] * np.eye(len(names)), tuple(names)
@@ -120,6 +143,6 @@ def read_csv(path, start: tuple[int, float] | None = None) -> Solution:
     if frame == "ned":
         vel = vel[:, [1, 0, 2]] * [1.0, 1.0, -1.0]
     euler, quat = _attitude(cols, path)
-    cov, names = _covariance(cols)
+    cov, names = _covariance(cols, path)
     return Solution(t=t, pos_ecef=pos, vel_enu=vel, quat_nb=quat, euler=euler, cov=cov, state_names=names,
                     config={"source": str(path)})
