@@ -233,3 +233,13 @@ def test_csv_full_covariance_columns_give_the_same_nees_as_the_solution(h5, trut
     bad.write_text("t_s,x_ecef_m,y_ecef_m,z_ecef_m,cov_pos_x__pos_n\n0,1,2,3,4\n")
     with pytest.raises(referee.RefereeInputError, match=r"column cov_pos_x__pos_n: expected cov_<a>__<b>"):
         referee.read_csv(bad)
+
+
+def test_truth_window_brackets_the_estimate_and_scores_the_same(h5, truth):
+    part = referee.read_truth(h5, 5.003, 6.5)
+    assert part.t[0] <= 5.003 < part.t[1] and part.t[-2] < 6.5 <= part.t[-1] and len(part.t) == 151   # 5.00 .. 6.50 s at 100 Hz
+    sol, _, _ = _perturbed(truth, step=7, pos_sd=0.2)
+    inside = (sol.t >= 5.003) & (sol.t <= 6.5)
+    sub = Solution(t=sol.t[inside], pos_ecef=sol.pos_ecef[inside])
+    a, b = referee.score(truth, sub), referee.score(part, sub)
+    assert a.statistics == b.statistics

@@ -8,6 +8,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import ScenarioError
 
 
@@ -51,8 +53,10 @@ def run(args) -> int:
         from ..plots import require_matplotlib
 
         require_matplotlib("--report")
-    truth = referee.read_truth(args.file)
     sol, label = referee.load_estimate(args.estimate, args.solution, referee.file_start(args.file))
+    finite = np.asarray(sol.t, dtype=float)[np.isfinite(sol.t)]
+    span = (finite.min(), finite.max()) if finite.size else (None, None)
+    truth = referee.read_truth(args.file, *span)    # only the truth the estimate needs
     sc = referee.score(truth, sol, spec, where=args.estimate)
     markdown = referee.to_markdown(sc, label, args.file)
     sys.stdout.write(markdown)

@@ -28,13 +28,19 @@ class Truth:
     quat_nb: np.ndarray
 
 
-def read_truth(path) -> Truth:
-    """``/truth/t``, ``pos_ecef``, ``vel_enu`` and ``quat_nb`` of the simkit file ``path``."""
+def read_truth(path, t_min: float | None = None, t_max: float | None = None) -> Truth:
+    """``/truth/t``, ``pos_ecef``, ``vel_enu`` and ``quat_nb`` of the simkit file ``path``; with ``t_min`` /
+    ``t_max`` (s) only the samples that bracket that span are read (bounded memory for long files)."""
     with open_dataset(path) as ds:
         missing = [k for k in ("t", "pos_ecef", "vel_enu", "quat_nb") if f"truth/{k}" not in ds]
         if missing:
             raise RefereeInputError(path, f"no /truth/{missing[0]} dataset: scoring needs the truth trajectory")
-        return Truth(*(ds[f"truth/{k}"][:] for k in ("t", "pos_ecef", "vel_enu", "quat_nb")))
+        t = ds["truth/t"][:]
+        lo = 0 if t_min is None else max(int(np.searchsorted(t, t_min, side="right")) - 1, 0)
+        hi = len(t) if t_max is None else min(int(np.searchsorted(t, t_max, side="left")) + 1, len(t))
+        if hi - lo < 2:   # the span misses the truth: keep two samples so that overlap() names the spans
+            lo, hi = 0, len(t)
+        return Truth(t[lo:hi], *(ds[f"truth/{k}"][lo:hi] for k in ("pos_ecef", "vel_enu", "quat_nb")))
 
 
 def overlap(truth: Truth, t: np.ndarray, where: str = "estimate") -> np.ndarray:
