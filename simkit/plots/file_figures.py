@@ -10,12 +10,21 @@ from .. import frames
 from ..io import open_dataset, solution_names
 from .common import require_matplotlib, save
 
+MAX_POINTS = 20_000        # truth samples drawn per curve (strided beyond that)
+MAX_EPOCHS = 2_000         # GNSS epochs drawn per satellite
+MAX_ALLAN = 1 << 22        # IMU samples analysed (4.2 M: 11.6 h at 100 Hz), bounded memory on long files
+
+
+def _stride(n: int, limit: int) -> int:
+    return max(1, -(-n // limit))
+
 
 def _trajectory(plt, ds):
     if "truth/pos_lla" not in ds:
         return None
-    t, lla = ds["truth/t"][:], ds["truth/pos_lla"][:]
-    enu = frames.ecef_to_enu_vec(ds["truth/pos_ecef"][:] - ds["truth/pos_ecef"][0], lla[0, 0], lla[0, 1])
+    k = _stride(len(ds["truth/t"]), MAX_POINTS)
+    t, lla = ds["truth/t"][::k], ds["truth/pos_lla"][::k]
+    enu = frames.ecef_to_enu_vec(ds["truth/pos_ecef"][::k] - ds["truth/pos_ecef"][0], lla[0, 0], lla[0, 1])
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1.2, 1]})
     a.plot(enu[:, 0] / 1e3, enu[:, 1] / 1e3, lw=1, label="truth")
     a.plot(enu[0, 0] / 1e3, enu[0, 1] / 1e3, "go", label="start")
@@ -37,7 +46,8 @@ def _trajectory(plt, ds):
 def _sky(plt, ds):
     if "gnss/truth/elevation" not in ds:
         return None
-    el, az = ds["gnss/truth/elevation"][:, 0], ds["gnss/truth/azimuth"][:, 0]
+    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
+    el, az = ds["gnss/truth/elevation"][::k, 0], ds["gnss/truth/azimuth"][::k, 0]
     ids = [str(s) for s in ds["gnss/sat_id"][:]]
     fig = plt.figure(figsize=(6.5, 6.5))
     ax = fig.add_subplot(projection="polar")
@@ -65,13 +75,14 @@ def _dops(plt, ds):
         return None
     from ..constellation import dops
 
-    t = ds["gnss/t"][:]
-    el, az = ds["gnss/truth/elevation"][:, 0], ds["gnss/truth/azimuth"][:, 0]
+    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
+    t = ds["gnss/t"][::k]
+    el, az = ds["gnss/truth/elevation"][::k, 0], ds["gnss/truth/azimuth"][::k, 0]
     signals = [str(s) for s in ds["gnss/signals"][:]]
-    tracked = np.any([np.isfinite(ds[f"gnss/obs/{s}/code"][:, 0]) for s in signals], axis=0)
+    tracked = np.any([np.isfinite(ds[f"gnss/obs/{s}/code"][::k, 0]) for s in signals], axis=0)
     system = np.array([str(s)[0] for s in ds["gnss/sat_id"][:]])
     d = dops(np.where(tracked, el, np.nan), az, 0.0, system)
-    fig, (a, b) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    fig, (a, b) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, layout="constrained")
     for code, name in (("G", "GPS"), ("C", "BeiDou")):
         if np.any(system == code):
             a.step(t, (tracked & (system == code)).sum(axis=1), where="post", label=name)
@@ -94,15 +105,16 @@ def _allan(plt, ds):
     from ..imu.allan import adev
 
     dt = 1.0 / ds.rate_hz("imu")
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), layout="constrained")
     for ax, (name, truth, unit, scale) in zip(axes, (("gyro", "omega_ib_b", "deg/h", 180 / np.pi * 3600),
                                                       ("accel", "f_ib_b", "m/s^2", 1.0))):
-        taus, dev, _ = adev(ds[f"imu/{name}"][:] - ds[f"truth/{truth}"][:], dt)
+        n = min(len(ds["imu/t"]), MAX_ALLAN)
+        taus, dev, _ = adev(ds[f"imu/{name}"][:n] - ds[f"truth/{truth}"][:n], dt)
         for a, axis in enumerate("xyz"):
             ax.loglog(taus, dev[:, a] * scale, ".-", ms=3, label=f"{axis} axis")
         ax.set_xlabel("averaging time tau [s]")
         ax.set_ylabel(f"Allan deviation [{unit}]")
-        ax.set_title(f"{name} error (measured - truth)")
+        ax.set_title(f"{name} error (measured - truth), first {n * dt:.0f} s")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     return fig
@@ -112,12 +124,13 @@ def _observations(plt, ds):
     signals = [str(s) for s in ds["gnss/signals"][:]] if "gnss/signals" in ds else []
     if not signals or f"gnss/truth/{signals[0]}/noise_code" not in ds:
         return None
-    t = ds["gnss/t"][:]
+    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
+    t = ds["gnss/t"][::k]
     fig, axes = plt.subplots(len(signals), 2, figsize=(11, 3.2 * len(signals)), squeeze=False, layout="constrained")
     for row, sig in zip(axes, signals):
         for ax, kind in zip(row, ("code", "carrier")):
-            err = ds[f"gnss/truth/{sig}/noise_{kind}"][:, 0] + ds[f"gnss/truth/{sig}/multipath_{kind}"][:, 0]
-            err = np.where(np.isfinite(ds[f"gnss/obs/{sig}/{kind}"][:, 0]), err, np.nan)
+            err = ds[f"gnss/truth/{sig}/noise_{kind}"][::k, 0] + ds[f"gnss/truth/{sig}/multipath_{kind}"][::k, 0]
+            err = np.where(np.isfinite(ds[f"gnss/obs/{sig}/{kind}"][::k, 0]), err, np.nan)
             ax.plot(t, err * (1.0 if kind == "code" else 1e3), ".", ms=2)
             ax.plot([], [], ".", label="one colour per satellite")
             ax.set_ylabel(f"{sig} {kind} [{'m' if kind == 'code' else 'mm'}]")
