@@ -54,6 +54,20 @@ def test_runner_feeds_samples_in_time_order_and_scores(air):
     assert res.score.statistics["position_3d"]["max"] < 1e-6
 
 
+@pytest.mark.parametrize("block", [1, 4, 11])
+def test_block_reading_gives_the_same_calls(air, monkeypatch, block):
+    """The file is streamed in blocks of GNSS epochs: blocks of 1, 4 (0-3, 4-7, 8-10) or exactly all 11 epochs
+    feed the filter exactly as one large block does."""
+    whole = Recorder()
+    referee.run(whole, air, duration_s=10.0)
+    from simkit.referee import plugin
+
+    monkeypatch.setattr(plugin, "BLOCK_EPOCHS", block)
+    blocks = Recorder()
+    res = referee.run(blocks, air, duration_s=10.0)
+    assert blocks.calls == whole.calls and res.timing["gnss_epochs"] == 11
+
+
 def test_a_filter_without_the_interface_is_named(air):
     with pytest.raises(referee.RefereeInputError, match="object has no predict, update, solution method"):
         referee.run(object(), air)

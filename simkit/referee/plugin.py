@@ -88,14 +88,18 @@ class RunResult:
     timing: dict
 
 
-def _gnss(ds) -> dict:
+BLOCK_EPOCHS = 600   # GNSS epochs (and the IMU samples between them) read at a time: bounded memory
+
+
+def _gnss_block(ds, m0: int, m1: int) -> dict:
+    """GNSS epochs m0..m1 of the file as arrays (per signal and kind for the observations)."""
     signals = [str(s) for s in ds["gnss/signals"][:]]
-    out = {"t": ds["gnss/t"][:], "sat_id": tuple(str(s) for s in ds["gnss/sat_id"][:]),
-           "sat_pos_ecef": ds["gnss/sat_pos_ecef"][:], "sat_clock": ds["gnss/sat_clock"][:],
+    out = {"t": ds["gnss/t"][m0:m1], "sat_id": tuple(str(s) for s in ds["gnss/sat_id"][:]),
+           "sat_pos_ecef": ds["gnss/sat_pos_ecef"][m0:m1], "sat_clock": ds["gnss/sat_clock"][m0:m1],
            "lever_arm_b": ds["gnss/antennas/lever_arm_b"][:],
            "wavelength_m": dict(zip(signals, ds["gnss/wavelength_m"][:].tolist()))}
     for kind in ("code", "carrier", "doppler", "cn0", "lli"):
-        out[kind] = {s: ds[f"gnss/obs/{s}/{kind}"][:] for s in signals}
+        out[kind] = {s: ds[f"gnss/obs/{s}/{kind}"][m0:m1] for s in signals}
     return out
 
 
@@ -107,16 +111,9 @@ def _epoch(g: dict, m: int, week: int, sow: float) -> GnssEpoch:
                      gps_sow=float((sow + t) % 604800))
 
 
-def _read(path, duration_s):
-    with open_dataset(path) as ds:
-        if "imu/gyro" not in ds or "gnss/t" not in ds:
-            raise RefereeInputError(path, "the plugin runner needs /imu and /gnss (a scenario with [imu] and [gnss])")
-        t = ds["imu/t"][:]
-        n = len(t) if duration_s is None else int(np.searchsorted(t, t[0] + duration_s, side="right"))
-        imu = (t[:n], ds["imu/gyro"][:n], ds["imu/accel"][:n])
-        gnss = _gnss(ds)
-        start = (int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]))
-    return imu, gnss, start
+def _check_file(ds, path):
+    if "imu/gyro" not in ds or "gnss/t" not in ds:
+        raise RefereeInputError(path, "the plugin runner needs /imu and /gnss (a scenario with [imu] and [gnss])")
 
 
 def _check_filter(flt):
@@ -126,40 +123,64 @@ def _check_filter(flt):
                                           f"(expected predict(imu), update(gnss), solution())")
 
 
+def _start(flt, ds, truth, t0: float, start):
+    if callable(getattr(flt, "start", None)):
+        i = int(np.searchsorted(truth.t, t0))
+        flt.start(InitialState(float(truth.t[i]), truth.pos_ecef[i], truth.vel_enu[i], truth.quat_nb[i],
+                               ds["gnss/antennas/lever_arm_b"][:], *start))
+
+
+def _feed(flt, ds, t_imu, n: int, start, clock: dict, bar) -> int:
+    """Give the filter every IMU sample (0..n) and every GNSS epoch up to t_imu[n - 1], block by block;
+    returns the number of GNSS epochs."""
+    nominal = t_imu[1] - t_imu[0] if n > 1 else 0.0
+    t_gnss = ds["gnss/t"][:]
+    n_epochs = int(np.searchsorted(t_gnss, t_imu[n - 1], side="right"))
+    k0 = 0
+    for m0 in range(0, n_epochs + 1, BLOCK_EPOCHS):
+        m1 = min(m0 + BLOCK_EPOCHS, n_epochs)
+        g = _gnss_block(ds, m0, m1)
+        ends = [*np.searchsorted(t_imu[:n], t_gnss[m0:m1], side="right"), n if m1 == n_epochs else None]
+        for j, k1 in enumerate(ends):
+            if k1 is None:
+                break
+            gyro, accel = ds["imu/gyro"][k0:k1], ds["imu/accel"][k0:k1]
+            dt = np.diff(t_imu[max(k0 - 1, 0):k1], prepend=[t_imu[0] - nominal] if k0 == 0 else [])
+            c0 = time.perf_counter()
+            for i in range(k1 - k0):
+                flt.predict(ImuSample(float(t_imu[k0 + i]), float(dt[i]), gyro[i], accel[i]))
+            c1 = time.perf_counter()
+            if j < m1 - m0:
+                flt.update(_epoch(g, j, *start))
+            clock["predict_s"] += c1 - c0
+            clock["update_s"] += time.perf_counter() - c1
+            bar.update(k1 - k0)
+            k0 = k1
+        if m1 == n_epochs:
+            break
+    return n_epochs
+
+
 def run(flt, path, spec: Spec | None = None, duration_s: float | None = None, progress: bool = False) -> RunResult:
     """Run filter ``flt`` over the simkit file ``path`` (the first ``duration_s`` seconds, or all), time it and
-    score its solution against the truth with ``spec``."""
+    score its solution against the truth with ``spec``. The file is read in blocks of :data:`BLOCK_EPOCHS`."""
     _check_filter(flt)
-    (t, gyro, accel), g, start = _read(path, duration_s)
-    truth = read_truth(path)
-    if callable(getattr(flt, "start", None)):
-        i = int(np.searchsorted(truth.t, t[0]))
-        flt.start(InitialState(float(truth.t[i]), truth.pos_ecef[i], truth.vel_enu[i], truth.quat_nb[i],
-                               g["lever_arm_b"], *start))
-    dt = np.diff(t, prepend=t[0] - (t[1] - t[0] if len(t) > 1 else 0.0))
-    epochs = np.flatnonzero(g["t"] <= t[-1])
-    after = np.searchsorted(t, g["t"][epochs], side="right")   # IMU samples to feed before each epoch
-    clock = {"predict_s": 0.0, "update_s": 0.0}
-    bar = _bar(progress, len(t))
-    k0 = 0
-    for m, k1 in zip([*epochs, None], [*after, len(t)]):
-        c0 = time.perf_counter()
-        for k in range(k0, k1):
-            flt.predict(ImuSample(float(t[k]), float(dt[k]), gyro[k], accel[k]))
-        c1 = time.perf_counter()
-        if m is not None:
-            flt.update(_epoch(g, m, *start))
-        clock["predict_s"] += c1 - c0
-        clock["update_s"] += time.perf_counter() - c1
-        bar.update(k1 - k0)
-        k0 = k1
-    bar.close()
+    with open_dataset(path) as ds:
+        _check_file(ds, path)
+        t_imu = ds["imu/t"][:]
+        n = len(t_imu) if duration_s is None else int(np.searchsorted(t_imu, t_imu[0] + duration_s, side="right"))
+        start = (int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]))
+        truth = read_truth(path, t_imu[0], t_imu[n - 1])
+        _start(flt, ds, truth, t_imu[0], start)
+        clock = {"predict_s": 0.0, "update_s": 0.0}
+        with _bar(progress, n) as bar:
+            epochs = _feed(flt, ds, t_imu, n, start, clock, bar)
     c0 = time.perf_counter()
     sol = flt.solution()
     clock["solution_s"] = time.perf_counter() - c0
     total = sum(clock.values())
-    timing = {**clock, "total_s": total, "imu_samples": int(len(t)), "gnss_epochs": int(len(epochs)),
-              "imu_samples_per_s": len(t) / total if total > 0 else float("inf")}
+    timing = {**clock, "total_s": total, "imu_samples": int(n), "gnss_epochs": epochs,
+              "imu_samples_per_s": n / total if total > 0 else float("inf")}
     return RunResult(sol, score(truth, sol, spec, where=type(flt).__name__), timing)
 
 
