@@ -131,24 +131,24 @@ def _start(flt, ds, truth, t0: float, start):
 
 
 def _feed(flt, ds, t_imu, n: int, start, clock: dict, bar) -> int:
-    """Give the filter every IMU sample (0..n) and every GNSS epoch up to t_imu[n - 1], block by block;
-    returns the number of GNSS epochs."""
+    """Give the filter every IMU sample (0..n) and every GNSS epoch up to t_imu[n - 1], block by block (the IMU
+    samples of a block of GNSS epochs are read at once); returns the number of GNSS epochs."""
     nominal = t_imu[1] - t_imu[0] if n > 1 else 0.0
+    dt = np.diff(t_imu[:n], prepend=t_imu[0] - nominal)
     t_gnss = ds["gnss/t"][:]
     n_epochs = int(np.searchsorted(t_gnss, t_imu[n - 1], side="right"))
+    after = np.searchsorted(t_imu[:n], t_gnss[:n_epochs], side="right")   # IMU samples before each epoch
     k0 = 0
     for m0 in range(0, n_epochs + 1, BLOCK_EPOCHS):
         m1 = min(m0 + BLOCK_EPOCHS, n_epochs)
         g = _gnss_block(ds, m0, m1)
-        ends = [*np.searchsorted(t_imu[:n], t_gnss[m0:m1], side="right"), n if m1 == n_epochs else None]
+        ends = [*after[m0:m1], *([n] if m1 == n_epochs else [])]
+        base, top = k0, (ends[-1] if ends else k0)
+        gyro, accel = ds["imu/gyro"][base:top], ds["imu/accel"][base:top]
         for j, k1 in enumerate(ends):
-            if k1 is None:
-                break
-            gyro, accel = ds["imu/gyro"][k0:k1], ds["imu/accel"][k0:k1]
-            dt = np.diff(t_imu[max(k0 - 1, 0):k1], prepend=[t_imu[0] - nominal] if k0 == 0 else [])
             c0 = time.perf_counter()
-            for i in range(k1 - k0):
-                flt.predict(ImuSample(float(t_imu[k0 + i]), float(dt[i]), gyro[i], accel[i]))
+            for k in range(k0, k1):
+                flt.predict(ImuSample(float(t_imu[k]), float(dt[k]), gyro[k - base], accel[k - base]))
             c1 = time.perf_counter()
             if j < m1 - m0:
                 flt.update(_epoch(g, j, *start))
