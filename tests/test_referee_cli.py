@@ -25,7 +25,8 @@ def work(tmp_path_factory):
                                       vel_enu=truth.vel_enu[k], quat_nb=truth.quat_nb[k], cov=cov,
                                       state_names=("pos_e", "pos_n", "pos_u")))
     (d / "est.csv").write_text("t_s,x_ecef_m,y_ecef_m,z_ecef_m\n" + "".join(
-        f"{float(t)!r},{float(p[0])!r},{float(p[1])!r},{float(p[2]) + 0.5!r}\n" for t, p in zip(truth.t[k], truth.pos_ecef[k])))
+        f"{float(t)!r},{float(p[0])!r},{float(p[1])!r},{float(p[2]) + 0.5!r}\n"
+        for t, p in zip(truth.t[k], truth.pos_ecef[k])))
     week, sow = referee.file_start(h5)
     (d / "gpst.csv").write_text("gps_week,gps_sow,x_ecef_m,y_ecef_m,z_ecef_m\n" + "".join(
         f"{week},{sow + float(t)!r},{float(p[0])!r},{float(p[1])!r},{float(p[2])!r}\n"

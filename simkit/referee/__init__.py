@@ -13,6 +13,6 @@ from .score import Score, score
 from .spec import Spec, load_spec, parse_spec
 from .truth import Truth, read_truth, truth_at
 
-__all__ = ["Errors", "GnssEpoch", "ImuSample", "InitialState", "RunResult", "run", "RefereeInputError", "Score", "Spec", "Truth", "compare", "file_start", "load_estimate",
-           "load_spec", "parse_spec", "quat_to_simkit", "read_csv", "read_truth", "score", "solution_from_ned",
-           "to_json", "to_markdown", "truth_at"]
+__all__ = ["Errors", "GnssEpoch", "ImuSample", "InitialState", "RefereeInputError", "RunResult", "Score", "Spec",
+           "Truth", "compare", "file_start", "load_estimate", "load_spec", "parse_spec", "quat_to_simkit", "read_csv",
+           "read_truth", "run", "score", "solution_from_ned", "to_json", "to_markdown", "truth_at"]

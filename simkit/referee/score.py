@@ -16,8 +16,8 @@ from .truth import Truth
 class Score:
     """The result of :func:`score`: ``errors`` (per epoch); ``statistics`` {quantity: {stat: value}} in the units
     of ``stats.UNIT_OF``; ``convergence`` {quantity: {threshold, time_s}}; ``nees`` / ``nis`` (dicts with
-    ``series``) or None; ``checks`` [{name, value, limit, passed}]; ``meta`` (epochs scored and dropped); ``sigmas`` {covariance
-    state name: (K,) standard deviation at the scored epochs, SI}."""
+    ``series``) or None; ``checks`` [{name, value, limit, passed}]; ``meta`` (epochs scored and dropped);
+    ``sigmas`` {covariance state name: (K,) standard deviation at the scored epochs, SI}."""
 
     errors: Errors
     statistics: dict
@@ -30,7 +30,7 @@ class Score:
 
     @property
     def passed(self) -> bool:
-        """True when every check passed (and there is at least none failing)."""
+        """True when no check failed (also when there is no check: see ``checks``)."""
         return all(c["passed"] for c in self.checks)
 
     def as_dict(self) -> dict:

@@ -62,9 +62,10 @@ def _quantity_table(where, section, name, table):
 
 def parse_spec(data: dict, where="spec") -> Spec:
     """A :class:`Spec` from the parsed TOML ``data``; unknown sections, quantities or keys are errors."""
+    sections = ("limits", "convergence", "consistency")
     for section in data:
-        if section not in ("limits", "convergence", "consistency"):
-            raise RefereeInputError(where, f"unknown section [{section}]{_hint(section, ('limits', 'convergence', 'consistency'))}")
+        if section not in sections:
+            raise RefereeInputError(where, f"unknown section [{section}]{_hint(section, sections)}")
     limits, conv = {}, {}
     for name, table in data.get("limits", {}).items():
         unit = _quantity_table(where, "limits", name, table)
