@@ -13,8 +13,9 @@ implements simkit's plugin interface (:mod:`simkit.referee.plugin`):
   converts its NED output and standard deviations to simkit's conventions with
   :func:`simkit.referee.solution_from_ned`; pyins' standardised position innovations give the NIS (3 dof).
 
-Run: ``python examples/pyins_loosely_coupled.py airborne_stim300.h5 [--duration 300] [--report DIR]``
-(simulate the file first with ``simkit run airborne_stim300``).
+Run: ``python examples/pyins_loosely_coupled.py airborne_stim300.h5 [--duration 300] [--report DIR] [--csv OUT]``
+(simulate the file first with ``simkit run airborne_stim300``); ``--csv`` writes pyins' native NED output, which
+``simkit score airborne_stim300.h5 OUT.csv --spec examples/spec_airborne.toml`` scores from the command line.
 """
 from __future__ import annotations
 
@@ -70,7 +71,7 @@ class PyinsLooselyCoupled:
         self.position_sd_m, self.signal, self.time_step_s = position_sd_m, signal, time_step_s
         self.gyro = gyro or {"bias_sd": np.full(3, 10 * DEG_H), "noise": np.full(3, 0.2 * np.pi / 180 / 60)}
         self.accel = accel or {"bias_sd": np.full(3, 1e-3 * 9.8), "noise": np.full(3, 0.1 / 60)}
-        self.imu, self.fixes, self.init, self.x = [], [], None, None
+        self.imu, self.fixes, self.init, self.x, self.native = [], [], None, None, None
 
     def start(self, init):
         self.init = init
@@ -117,6 +118,7 @@ class PyinsLooselyCoupled:
             time_step=self.time_step_s)
         sd = result.trajectory_sd
         traj = result.trajectory.loc[sd.index]
+        self.native = (traj, sd)
         # pyins returns standardised innovations (identity covariance): their squared norm is the NIS
         nu = result.innovations["Position"]
         nis = pd.Series((nu.values ** 2).sum(axis=1), index=nu.index).reindex(sd.index)
@@ -133,14 +135,32 @@ class PyinsLooselyCoupled:
                                    extra_units={"nis": "1", "nis_dof": "1"})
 
 
+def write_native_csv(path, traj, sd) -> None:
+    """pyins' own output (NED, degrees, roll/pitch/heading) as a simkit score CSV (docs/referee.md columns)."""
+    table = pd.DataFrame({
+        "t_s": traj.index.values, "lat_deg": traj.lat.values, "lon_deg": traj.lon.values, "h_m": traj.alt.values,
+        "vel_n_m_per_s": traj.VN.values, "vel_e_m_per_s": traj.VE.values, "vel_d_m_per_s": traj.VD.values,
+        "roll_deg": traj.roll.values, "pitch_deg": traj.pitch.values, "heading_deg": traj.heading.values,
+        "sd_n_m": sd.north.values, "sd_e_m": sd.east.values, "sd_d_m": sd.down.values,
+        "sd_vel_n_m_per_s": sd.VN.values, "sd_vel_e_m_per_s": sd.VE.values, "sd_vel_d_m_per_s": sd.VD.values,
+        "sd_roll_deg": sd.roll.values, "sd_pitch_deg": sd.pitch.values, "sd_heading_deg": sd.heading.values})
+    with open(path, "w") as f:
+        f.write("# pyins.filters.run_feedback_filter output, NED / forward-right-down, degrees\n")
+        table.to_csv(f, index=False, float_format="%.10f")
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description="Referee pyins' loosely coupled filter on a simkit file.")
     p.add_argument("file")
     p.add_argument("--duration", type=float, help="seconds of the file to use (default: all)")
     p.add_argument("--json", help="write the score and timing as JSON")
     p.add_argument("--report", help="directory for the Markdown report and error plots")
+    p.add_argument("--csv", help="also write pyins' native NED output as a CSV for `simkit score`")
     args = p.parse_args(argv)
-    res = referee.run(PyinsLooselyCoupled(), args.file, duration_s=args.duration, progress=True)
+    flt = PyinsLooselyCoupled()
+    res = referee.run(flt, args.file, duration_s=args.duration, progress=True)
+    if args.csv:
+        write_native_csv(args.csv, *flt.native)
     sys.stdout.write(referee.to_markdown(res.score, "pyins run_feedback_filter (loosely coupled)", args.file))
     print("timing: " + ", ".join(f"{k} {v:.4g}" for k, v in res.timing.items()))
     if args.json:

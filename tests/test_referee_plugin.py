@@ -1,6 +1,7 @@
 """The plugin runner: samples reach a filter in time order with GNSS epochs after the IMU samples up to their
 time; bad filters are named; pyins' loosely coupled filter (a third-party filter in NED / forward-right-down
 conventions, examples/pyins_loosely_coupled.py) runs end to end on airborne_stim300 and is scored."""
+import json
 import sys
 
 import numpy as np
@@ -10,7 +11,7 @@ import simkit
 from simkit import referee
 from simkit.solution import Solution
 
-from cli_errors import ROOT
+from cli_errors import ROOT, run_cli
 
 
 @pytest.fixture(scope="module")
@@ -74,11 +75,12 @@ def test_a_filter_without_the_interface_is_named(air):
 
 
 @pytest.mark.slow   # pyins' batch filter runs in pandas: about 10 s for 40 s of data
-def test_pyins_loosely_coupled_end_to_end(air):
+def test_pyins_loosely_coupled_end_to_end(air, tmp_path):
     sys.path.insert(0, str(ROOT / "examples"))
-    from pyins_loosely_coupled import PyinsLooselyCoupled
+    from pyins_loosely_coupled import PyinsLooselyCoupled, write_native_csv
 
-    res = referee.run(PyinsLooselyCoupled(), air)
+    flt = PyinsLooselyCoupled()
+    res = referee.run(flt, air)
     sc = res.score
     assert sc.meta["epochs_scored"] == 40
     # metre-level code fixes with their ionospheric delay: metres horizontally, a few tenths of a degree
@@ -87,6 +89,14 @@ def test_pyins_loosely_coupled_end_to_end(air):
     assert sc.nees["states"] == ["pos_n", "pos_e", "pos_d", "vel_n", "vel_e", "vel_d", "roll", "pitch", "heading"]
     assert res.timing["solution_s"] > 0 and res.solution.config["fixes"] == 41
     assert sc.nis["epochs"] == 40 and sc.nis["dof_mean"] == 3.0          # pyins' standardised innovations
+    # pyins' native NED output as a CSV, scored from the command line, gives the plugin's numbers
+    write_native_csv(tmp_path / "pyins.csv", *flt.native)
+    out = run_cli(["score", str(air), "pyins.csv", "--spec", str(ROOT / "examples" / "spec_airborne.toml"),
+                   "--json", "s.json"], tmp_path)
+    assert out.returncode in (0, 1) and "## Checks" in out.stdout, out.stderr
+    csv_stats = json.loads((tmp_path / "s.json").read_text())["statistics"]
+    for q in ("horizontal", "up", "velocity_3d", "pitch", "roll", "heading"):
+        assert csv_stats[q]["rms"] == pytest.approx(sc.statistics[q]["rms"], rel=1e-6, abs=1e-6), q
 
 
 @pytest.mark.slow   # 120 s at 100 Hz through pyins: about 5 s
