@@ -118,10 +118,10 @@ class PyinsLooselyCoupled:
             time_step=self.time_step_s)
         sd = result.trajectory_sd
         traj = result.trajectory.loc[sd.index]
-        self.native = (traj, sd)
         # pyins returns standardised innovations (identity covariance): their squared norm is the NIS
         nu = result.innovations["Position"]
         nis = pd.Series((nu.values ** 2).sum(axis=1), index=nu.index).reindex(sd.index)
+        self.native = (traj, sd, nis)
         sol = referee.solution_from_ned(
             traj.index.values, np.radians(traj.lat.values), np.radians(traj.lon.values), traj.alt.values,
             vel_ned=traj[["VN", "VE", "VD"]].values, roll=np.radians(traj.roll.values),
@@ -135,15 +135,17 @@ class PyinsLooselyCoupled:
                                    extra_units={"nis": "1", "nis_dof": "1"})
 
 
-def write_native_csv(path, traj, sd) -> None:
-    """pyins' own output (NED, degrees, roll/pitch/heading) as a simkit score CSV (docs/referee.md columns)."""
+def write_native_csv(path, traj, sd, nis) -> None:
+    """pyins' own output (NED, degrees, roll/pitch/heading, standard deviations) and the NIS of its position
+    innovations as a simkit score CSV (docs/referee.md columns)."""
     table = pd.DataFrame({
         "t_s": traj.index.values, "lat_deg": traj.lat.values, "lon_deg": traj.lon.values, "h_m": traj.alt.values,
         "vel_n_m_per_s": traj.VN.values, "vel_e_m_per_s": traj.VE.values, "vel_d_m_per_s": traj.VD.values,
         "roll_deg": traj.roll.values, "pitch_deg": traj.pitch.values, "heading_deg": traj.heading.values,
         "sd_n_m": sd.north.values, "sd_e_m": sd.east.values, "sd_d_m": sd.down.values,
         "sd_vel_n_m_per_s": sd.VN.values, "sd_vel_e_m_per_s": sd.VE.values, "sd_vel_d_m_per_s": sd.VD.values,
-        "sd_roll_deg": sd.roll.values, "sd_pitch_deg": sd.pitch.values, "sd_heading_deg": sd.heading.values})
+        "sd_roll_deg": sd.roll.values, "sd_pitch_deg": sd.pitch.values, "sd_heading_deg": sd.heading.values,
+        "nis": nis.values, "nis_dof": np.where(np.isfinite(nis.values), 3, 0)})
     with open(path, "w") as f:
         f.write("# pyins.filters.run_feedback_filter output, NED / forward-right-down, degrees\n")
         table.to_csv(f, index=False, float_format="%.10f")

@@ -97,6 +97,8 @@ def test_pyins_loosely_coupled_end_to_end(air, tmp_path):
     csv_stats = json.loads((tmp_path / "s.json").read_text())["statistics"]
     for q in ("horizontal", "up", "velocity_3d", "pitch", "roll", "heading"):
         assert csv_stats[q]["rms"] == pytest.approx(sc.statistics[q]["rms"], rel=1e-6, abs=1e-6), q
+    nis = json.loads((tmp_path / "s.json").read_text())["nis"]
+    assert nis["epochs"] == sc.nis["epochs"] and nis["mean"] == pytest.approx(sc.nis["mean"], rel=1e-6)
 
 
 @pytest.mark.slow   # 120 s at 100 Hz through pyins: about 5 s

@@ -10,6 +10,8 @@ comments. Column names carry frame and unit; their order is free.
 | standard deviations (optional) | ``sd_e_m, sd_n_m, sd_u_m`` / ``sd_d_m``; ``sd_vel_e_m_per_s`` ... ``sd_vel_d_m_per_s``; ``sd_roll_deg, sd_pitch_deg, sd_heading_deg`` (or ``_rad``) |
 | or a covariance (optional) | ``cov_<a>__<b>`` for covariance state names a, b (``pos_n``, ``vel_d``, ``att_e``, ``heading``, ... see ``compare.STATE_SERIES``), SI units (m^2, m^2/s^2, rad^2, m rad, ...); one of each pair is enough; missing pairs are 0 |
 
+| NIS (optional) | ``nis`` and ``nis_dof``: a filter's normalised innovation squared and its degrees of freedom (empty or 0 where no update) |
+
 The standard deviations give a diagonal covariance (states ``pos_e`` ... ``heading``) for the NEES test.
 """
 from __future__ import annotations
@@ -144,5 +146,7 @@ def read_csv(path, start: tuple[int, float] | None = None) -> Solution:
         vel = vel[:, [1, 0, 2]] * [1.0, 1.0, -1.0]
     euler, quat = _attitude(cols, path)
     cov, names = _covariance(cols, path)
+    nis = _group(cols, path, ["nis", "nis_dof"], "NIS")
+    extras = {} if nis is None else {"nis": nis[:, 0], "nis_dof": np.nan_to_num(nis[:, 1])}
     return Solution(t=t, pos_ecef=pos, vel_enu=vel, quat_nb=quat, euler=euler, cov=cov, state_names=names,
-                    config={"source": str(path)})
+                    extras=extras, config={"source": str(path)})
