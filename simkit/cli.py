@@ -15,7 +15,7 @@ import sys
 from .errors import SimkitError
 from .version import __version__
 
-COMMANDS = ("run", "inspect", "allan", "sky", "rinex", "validate", "campaign")
+COMMANDS = ("run", "inspect", "allan", "sky", "rinex", "validate", "campaign", "score", "regress", "plot")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -1,0 +1,38 @@
+"""``simkit plot FILE.h5 [--out DIR]``: overview figures of a simkit file as PNGs (needs the ``plot`` extra)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import ScenarioError
+
+
+def add_parser(sub):
+    p = sub.add_parser("plot", help="overview figures of a file: trajectory, sky, DOPs, Allan, observations, "
+                                    "solutions vs truth",
+                       description="Write PNG figures: trajectory map and altitude, sky plot, tracked satellites "
+                                   "and DOPs, IMU Allan deviation, observation errors, and each /solutions group "
+                                   "against the truth with +-3 sigma bounds. Needs matplotlib (the 'plot' extra).")
+    p.add_argument("file", help="simkit HDF5 file")
+    p.add_argument("--out", metavar="DIR", default="plots", help="output directory (created; default ./plots)")
+    return p
+
+
+def run(args) -> int:
+    from tqdm import tqdm
+
+    from ..io import open_dataset
+    from ..plots import FIGURES, file_figures, require_matplotlib
+
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ScenarioError("--out", f"{args.out} exists and is not a directory")
+    if not out.parent.is_dir():
+        raise ScenarioError("--out", f"{args.out}: directory {str(out.parent)!r} does not exist")
+    require_matplotlib("simkit plot")
+    open_dataset(args.file).close()
+    out.mkdir(exist_ok=True)
+    with tqdm(total=len(FIGURES), desc="plot", unit="figure", leave=False) as bar:
+        paths = file_figures(args.file, out, bar)
+    for p in paths:
+        print(p)
+    return 0

@@ -1,0 +1,72 @@
+"""``simkit score FILE.h5 ESTIMATE``: errors of an estimate (a /solutions group or a CSV) against the truth.
+
+Every check on the arguments and inputs runs before any computing; bad input is one line on stderr and exit 2.
+Exit code 1 when a spec is given and a check fails.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ScenarioError
+
+
+def add_parser(sub):
+    p = sub.add_parser("score", help="score an estimate (HDF5 /solutions or CSV) against the file's truth",
+                       description="Align the estimate's epochs with the truth, convert frames and conventions, and "
+                                   "report ENU position/velocity and pitch/roll/heading errors: RMS, max, 50/95/99 %"
+                                   " percentiles, convergence time, NEES/NIS with chi-square bounds, and pass/fail "
+                                   "against a TOML spec. Exit 1 when a spec check fails.")
+    p.add_argument("file", help="simkit HDF5 file holding the truth")
+    p.add_argument("estimate", help="a simkit HDF5 file with /solutions (the same file is fine) or a CSV "
+                                    "(columns: docs/referee.md)")
+    p.add_argument("--solution", metavar="NAME", help="which /solutions/NAME to score (needed when several)")
+    p.add_argument("--spec", metavar="PASS.toml", help="thresholds for pass/fail (docs/referee.md)")
+    p.add_argument("--json", metavar="OUT", help="write the scores as JSON")
+    p.add_argument("--report", metavar="DIR", help="write report.md and error plots (needs the 'plot' extra) here")
+    return p
+
+
+def _check_outputs(args):
+    if args.json:
+        parent = Path(args.json).parent
+        if not parent.is_dir():
+            raise ScenarioError("--json", f"{args.json}: directory {str(parent)!r} does not exist")
+        if Path(args.json).is_dir():
+            raise ScenarioError("--json", f"{args.json} is a directory, expected a file name")
+    if args.report:
+        report = Path(args.report)
+        if report.exists() and not report.is_dir():
+            raise ScenarioError("--report", f"{args.report} exists and is not a directory")
+        if not report.parent.is_dir():
+            raise ScenarioError("--report", f"{args.report}: directory {str(report.parent)!r} does not exist")
+
+
+def run(args) -> int:
+    from .. import referee
+
+    _check_outputs(args)
+    spec = referee.load_spec(args.spec) if args.spec else None
+    if args.report:
+        from ..plots import require_matplotlib
+
+        require_matplotlib("--report")
+    sol, label = referee.load_estimate(args.estimate, args.solution, referee.file_start(args.file))
+    finite = np.asarray(sol.t, dtype=float)[np.isfinite(sol.t)]
+    span = (finite.min(), finite.max()) if finite.size else (None, None)
+    truth = referee.read_truth(args.file, *span)    # only the truth the estimate needs
+    sc = referee.score(truth, sol, spec, where=args.estimate)
+    markdown = referee.to_markdown(sc, label, args.file)
+    sys.stdout.write(markdown)
+    if args.json:
+        Path(args.json).write_text(referee.to_json(sc, label))
+    if args.report:
+        from ..plots import score_figures
+
+        out = Path(args.report)
+        out.mkdir(exist_ok=True)
+        (out / "report.md").write_text(markdown + "".join(f"\n![{p.stem}]({p.name})\n"
+                                                          for p in score_figures(sc, out, label)))
+    return 0 if sc.passed else 1

@@ -1,0 +1,179 @@
+"""The overview figures of a simkit file (``simkit plot FILE.h5``): one PNG per figure, each made only when the
+file holds what it needs (a file without /gnss has no sky plot)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .. import frames
+from ..io import open_dataset, solution_names
+from .common import require_matplotlib, save
+
+MAX_POINTS = 20_000        # truth samples drawn per curve (strided beyond that)
+MAX_EPOCHS = 2_000         # GNSS epochs drawn per satellite
+MAX_ALLAN = 1 << 22        # IMU samples analysed (4.2 M: 11.6 h at 100 Hz), bounded memory on long files
+
+
+def _stride(n: int, limit: int) -> int:
+    return max(1, -(-n // limit))
+
+
+def _trajectory(plt, ds):
+    if "truth/pos_lla" not in ds:
+        return None
+    k = _stride(len(ds["truth/t"]), MAX_POINTS)
+    t, lla = ds["truth/t"][::k], ds["truth/pos_lla"][::k]
+    enu = frames.ecef_to_enu_vec(ds["truth/pos_ecef"][::k] - ds["truth/pos_ecef"][0], lla[0, 0], lla[0, 1])
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1.2, 1]})
+    a.plot(enu[:, 0] / 1e3, enu[:, 1] / 1e3, lw=1, label="truth")
+    a.plot(enu[0, 0] / 1e3, enu[0, 1] / 1e3, "go", label="start")
+    a.plot(enu[-1, 0] / 1e3, enu[-1, 1] / 1e3, "rs", label="end")
+    a.set_xlabel("east of start [km]")
+    a.set_ylabel("north of start [km]")
+    a.set_aspect("equal", adjustable="datalim")
+    a.set_title(f"trajectory map (origin {np.degrees(lla[0, 0]):.4f} N, {np.degrees(lla[0, 1]):.4f} E)")
+    b.plot(t, lla[:, 2], lw=1, label="ellipsoidal height")
+    b.set_xlabel("time since scenario start [s]")
+    b.set_ylabel("height [m]")
+    b.set_title("altitude")
+    for ax in (a, b):
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    return fig
+
+
+def _sky(plt, ds):
+    if "gnss/truth/elevation" not in ds:
+        return None
+    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
+    el, az = ds["gnss/truth/elevation"][::k, 0], ds["gnss/truth/azimuth"][::k, 0]
+    ids = [str(s) for s in ds["gnss/sat_id"][:]]
+    fig = plt.figure(figsize=(6.5, 6.5))
+    ax = fig.add_subplot(projection="polar")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    seen = set()
+    for s in np.flatnonzero(np.any(el > 0, axis=0)):
+        up = el[:, s] > 0
+        system = ids[s][0]
+        color = {"G": "tab:blue", "C": "tab:red"}.get(system, "tab:gray")
+        ax.plot(az[up, s], 90 - np.degrees(el[up, s]), ".", ms=2, color=color,
+                label={"G": "GPS", "C": "BeiDou"}.get(system, system) if system not in seen else None)
+        seen.add(system)
+        k = np.flatnonzero(up)[-1]
+        ax.annotate(ids[s], (az[k, s], 90 - np.degrees(el[k, s])), fontsize=7)
+    ax.set_ylim(0, 90)
+    ax.set_yticks([0, 30, 60, 90], labels=["90 deg", "60 deg", "30 deg", "0 deg"])
+    ax.set_title("sky plot, antenna 0 (azimuth clockwise from north, elevation in deg)")
+    ax.legend(loc="lower left", fontsize=8)
+    return fig
+
+
+def _dops(plt, ds):
+    if "gnss/truth/elevation" not in ds:
+        return None
+    from ..constellation import dops
+
+    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
+    t = ds["gnss/t"][::k]
+    el, az = ds["gnss/truth/elevation"][::k, 0], ds["gnss/truth/azimuth"][::k, 0]
+    signals = [str(s) for s in ds["gnss/signals"][:]]
+    tracked = np.any([np.isfinite(ds[f"gnss/obs/{s}/code"][::k, 0]) for s in signals], axis=0)
+    system = np.array([str(s)[0] for s in ds["gnss/sat_id"][:]])
+    d = dops(np.where(tracked, el, np.nan), az, 0.0, system)
+    fig, (a, b) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, layout="constrained")
+    for code, name in (("G", "GPS"), ("C", "BeiDou")):
+        if np.any(system == code):
+            a.step(t, (tracked & (system == code)).sum(axis=1), where="post", label=name)
+    a.step(t, tracked.sum(axis=1), where="post", color="k", label="all")
+    a.set_ylabel("tracked satellites [count]")
+    a.set_title("satellites tracked on any signal, antenna 0")
+    for key in "GPHV":
+        b.plot(t, d[key], label=f"{key}DOP")
+    b.set_ylabel("DOP [1]")
+    b.set_xlabel("time since scenario start [s]")
+    for ax in (a, b):
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8, loc="upper right")
+    return fig
+
+
+def _allan(plt, ds):
+    if "imu/gyro" not in ds or "truth/omega_ib_b" not in ds or len(ds["imu/t"]) < 100:
+        return None
+    from ..imu.allan import adev
+
+    dt = 1.0 / ds.rate_hz("imu")
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), layout="constrained")
+    for ax, (name, truth, unit, scale) in zip(axes, (("gyro", "omega_ib_b", "deg/h", 180 / np.pi * 3600),
+                                                      ("accel", "f_ib_b", "m/s^2", 1.0))):
+        n = min(len(ds["imu/t"]), MAX_ALLAN)
+        taus, dev, _ = adev(ds[f"imu/{name}"][:n] - ds[f"truth/{truth}"][:n], dt)
+        for a, axis in enumerate("xyz"):
+            ax.loglog(taus, dev[:, a] * scale, ".-", ms=3, label=f"{axis} axis")
+        ax.set_xlabel("averaging time tau [s]")
+        ax.set_ylabel(f"Allan deviation [{unit}]")
+        ax.set_title(f"{name} error (measured - truth), first {n * dt:.0f} s")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    return fig
+
+
+def _observations(plt, ds):
+    signals = [str(s) for s in ds["gnss/signals"][:]] if "gnss/signals" in ds else []
+    if not signals or f"gnss/truth/{signals[0]}/noise_code" not in ds:
+        return None
+    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
+    t = ds["gnss/t"][::k]
+    fig, axes = plt.subplots(len(signals), 2, figsize=(11, 3.2 * len(signals)), squeeze=False, layout="constrained")
+    for row, sig in zip(axes, signals):
+        for ax, kind in zip(row, ("code", "carrier")):
+            err = ds[f"gnss/truth/{sig}/noise_{kind}"][::k, 0] + ds[f"gnss/truth/{sig}/multipath_{kind}"][::k, 0]
+            err = np.where(np.isfinite(ds[f"gnss/obs/{sig}/{kind}"][::k, 0]), err, np.nan)
+            ax.plot(t, err * (1.0 if kind == "code" else 1e3), ".", ms=2)
+            ax.plot([], [], ".", label="one colour per satellite")
+            ax.set_ylabel(f"{sig} {kind} [{'m' if kind == 'code' else 'mm'}]")
+            ax.set_title(f"{sig} {kind}: noise + multipath, antenna 0")
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=8, loc="upper right")
+    for ax in axes[-1]:
+        ax.set_xlabel("time since scenario start [s]")
+    return fig
+
+
+FIGURES = {"trajectory": _trajectory, "sky": _sky, "satellites_dop": _dops, "imu_allan": _allan,
+           "observation_errors": _observations}
+
+
+def file_figures(path, out, progress=None) -> list[Path]:
+    """Write every overview figure that ``path`` has the data for, plus one error figure set per stored
+    solution (under ``out/solution_<name>/``); returns the PNG paths."""
+    plt = require_matplotlib()
+    out = Path(out)
+    paths = []
+    with open_dataset(path) as ds:
+        for name, make in FIGURES.items():
+            fig = make(plt, ds)
+            if fig is not None:
+                save(fig, out / f"{name}.png")
+                paths.append(out / f"{name}.png")
+            if progress is not None:
+                progress.update(1)
+    return paths + _solutions(path, out)
+
+
+def _solutions(path, out) -> list[Path]:
+    from ..io import read_solution
+    from ..referee import read_truth, score
+    from .score_figures import score_figures
+
+    paths = []
+    names = solution_names(path)
+    if names:
+        truth = read_truth(path)
+        for name in names:
+            folder = out / f"solution_{name}"
+            folder.mkdir(exist_ok=True)
+            paths += score_figures(score(truth, read_solution(path, name)), folder, f"/solutions/{name}")
+    return paths
