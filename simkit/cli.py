@@ -15,7 +15,7 @@ import sys
 from .errors import SimkitError
 from .version import __version__
 
-COMMANDS = ("run", "inspect", "allan", "sky", "rinex")
+COMMANDS = ("run", "inspect", "allan", "sky", "rinex", "solve")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -158,9 +158,11 @@ class KalmanFilter15(_LooselyCoupled):
 
 
 class KalmanFilter21(_LooselyCoupled):
-    """21-state filter (Badshah 2015): the lever arm is a state; GNSS attitude fixes are used when given."""
+    """Badshah 2015's "21-state" filter: the 15 states plus the lever arm (body, m) as a state, and GNSS
+    attitude fixes when given. The paper's own state list (attitude, velocity, position, gyro drift, accel bias,
+    lever arm: 6 x 3) has 18 entries, so the solution carries 18 states; the name follows the paper."""
 
-    n_states = 21
+    n_states = 18
     name = "kf21"
 
 

@@ -7,8 +7,9 @@ H-infinity (theta = gamma^-2):
          A = I - theta P + H^T R^-1 H P,  K = P A^-1 H^T R^-1,  x = x + K nu,  P = P A^-1,
          existence: P^-1 - theta I + H^T R^-1 H > 0 (its smallest eigenvalue is recorded as the margin);
          gamma adapts as in Wu 2015: gamma^2 = alpha * max eig((P^-1 + H^T H)^-1), alpha > 1.
-         When the margin is not positive, theta is lowered to half the smallest eigenvalue of P^-1 + H^T R^-1 H
-         (gamma raised) so that it is, and the status records it: the condition is never violated silently.
+         P+ = (P^-1 - theta I + H^T R^-1 H)^-1 is computed through the Cholesky factor of P (see _existence).
+         When the margin is not positive, theta is halved (gamma raised) until it is, and the status records
+         it: the condition is never violated silently.
 """
 from __future__ import annotations
 
@@ -60,38 +61,49 @@ def correct(x, p, nu, h, r):
 
 
 @njit(cache=True)
-def hinf_gamma(p_inv, h, alpha):
-    """Wu 2015's adaptive gamma: sqrt(alpha * max eig((P^-1 + H^T H)^-1))."""
-    lam = np.linalg.eigvalsh(p_inv + h.T @ h)
-    return np.sqrt(alpha / lam[0])
+def hinf_gamma(p, h, alpha):
+    """Wu 2015's adaptive gamma: sqrt(alpha * max eig((P^-1 + H^T H)^-1)), with (P^-1 + H^T H)^-1 formed as
+    P - P H^T (I + H P H^T)^-1 H P (matrix inversion lemma: no inverse of the ill-scaled P)."""
+    hp = h @ p
+    m = p - hp.T @ np.linalg.solve(np.eye(h.shape[0]) + hp @ h.T, hp)
+    return np.sqrt(alpha * np.linalg.eigvalsh(0.5 * (m + m.T))[-1])
+
+
+@njit(cache=True)
+def _existence(l, h, r_inv, theta):
+    """L^T (P^-1 - theta I + H^T R^-1 H) L = I - theta L^T L + (H L)^T R^-1 (H L) for P = L L^T: congruent to the
+    existence matrix (same inertia, Sylvester), but well scaled whatever the state units."""
+    hl = h @ l
+    e = np.eye(l.shape[0]) - theta * (l.T @ l) + hl.T @ r_inv @ hl
+    return 0.5 * (e + e.T)
 
 
 @njit(cache=True)
 def correct_hinf(x, p, nu, h, r, alpha):
-    """H-infinity correction. Returns (x, P, nis, w, gamma, margin, status); see the module docstring."""
-    n = p.shape[0]
-    p_inv = np.linalg.inv(p)
-    p_inv = 0.5 * (p_inv + p_inv.T)
-    r_inv = np.linalg.inv(r)
-    hrh = h.T @ r_inv @ h
-    gamma = hinf_gamma(p_inv, h, alpha)
-    theta = 1.0 / gamma**2
-    margin = np.linalg.eigvalsh(p_inv - theta * np.eye(n) + hrh)[0]
-    status = STATUS_OK
-    if not margin > 0.0:
-        theta = 0.5 * np.linalg.eigvalsh(p_inv + hrh)[0]
-        gamma = 1.0 / np.sqrt(theta)
-        margin = np.linalg.eigvalsh(p_inv - theta * np.eye(n) + hrh)[0]
-        status = STATUS_GAMMA_RAISED
+    """H-infinity correction. Returns (x, P, nis, w, gamma, margin, status); see the module docstring. The
+    margin is the smallest eigenvalue of the congruent, dimensionless form of the existence matrix."""
+    l = _chol(p)
     s = h @ p @ h.T + r
-    l = _chol(s)
-    if l.shape[0] == 0 or not margin > 0.0:
-        return x, p, np.nan, np.full(nu.size, np.nan), gamma, margin, STATUS_S_NOT_PD
-    w = np.linalg.solve(l, nu)
-    a_inv = np.linalg.inv(np.eye(n) - theta * p + hrh @ p)
-    k = p @ a_inv @ h.T @ r_inv
-    p_new = p @ a_inv
-    return x + k @ nu, 0.5 * (p_new + p_new.T), np.sum(w * w), w, gamma, margin, status
+    ls = _chol(s)
+    if l.shape[0] == 0 or ls.shape[0] == 0:
+        return x, p, np.nan, np.full(nu.size, np.nan), np.nan, np.nan, STATUS_S_NOT_PD
+    r_inv = np.linalg.inv(r)
+    gamma = hinf_gamma(p, h, alpha)
+    theta = 1.0 / gamma**2
+    e = _existence(l, h, r_inv, theta)
+    margin = np.linalg.eigvalsh(e)[0]
+    status = STATUS_OK
+    while not margin > 0.0 and theta > 1e-300:
+        theta *= 0.5
+        e = _existence(l, h, r_inv, theta)
+        margin = np.linalg.eigvalsh(e)[0]
+        status = STATUS_GAMMA_RAISED
+    gamma = 1.0 / np.sqrt(theta)
+    p_new = l @ np.linalg.solve(e, l.T)
+    p_new = 0.5 * (p_new + p_new.T)
+    k = p_new @ h.T @ r_inv
+    w = np.linalg.solve(ls, nu)
+    return x + k @ nu, p_new, np.sum(w * w), w, gamma, margin, status
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ def _feedback(x, c, v, pos, bg, ba, lever):
     pos = pos - x[6:9]
     bg = bg + x[9:12]
     ba = ba + x[12:15]
-    if x.size >= 21:
+    if x.size >= 18:
         lever = lever - x[15:18]
     return c, v, pos, bg, ba, lever
 

@@ -142,7 +142,7 @@ def antenna_rows(c, v, pos, lever, w_ib_b, n):
     h[0:3, 6:9] = np.eye(3)
     h[3:6, 0:3] = nav.skew(cwl)
     h[3:6, 3:6] = np.eye(3)
-    if n >= 21:
+    if n >= 18:
         h[0:3, 15:18] = tp @ c
         h[3:6, 15:18] = c @ nav.skew(w_nb)
     return pred, h
