@@ -40,7 +40,7 @@ def add_parser(sub):
 
 def parse_overrides(items: list[str]) -> dict:
     """``estimator.key=value`` items -> {key: value} (values parsed as TOML literals)."""
-    from ..scenario import parse_value
+    from ..scenario.loader import parse_value
 
     params = {}
     for item in items:
