@@ -2,12 +2,13 @@
 
 Model per satellite s at epoch k (one signal per satellite, the first tracked in the order given):
     P + c dT^s - GD^s - T(el) = |r^s - r| + w_e (x^s y - y^s x) / c + c dt_sys(s) + e
-    -lambda D + c dT^s' - e_s . v^s = -e_s . v + c dt'
+    -lambda D + c dT^s' - e_s . v^s - w_e (v^s_x y - v^s_y x) / c = -e_s . v + c dt'
 with r^s, dT^s the file's satellite position at emission and clock (RTKLIB's satposs convention, the Sagnac term
 added here), GD the code group delay of ``/gnss/group_delay``, T the Saastamoinen slant delay of
 :mod:`simkit.gnss.atmosphere`, one receiver clock per system (G, C, ...), one clock drift; the ionosphere is not
 modelled (single frequency, no broadcast coefficients in the file), which biases the fix by metres. Satellite
-velocity and clock drift are central differences of the stored epochs. Weights sin^2(el) / sigma^2; the
+velocity and clock drift are central differences of the stored epochs (second order at the ends); the receiver's
+own Sagnac-rate term (w_e (x^s v_y - y^s v_x) / c, under 1 mm/s) is left out. Weights sin^2(el) / sigma^2; the
 covariance is sigma^2 (A^T W A)^-1 with the a-priori ``sigma_code_m`` and ``sigma_doppler_m_per_s``.
 """
 from __future__ import annotations
@@ -105,8 +106,8 @@ def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, grou
     n_used = used.sum(1)
     good = ok & (n_used >= 3 + (onehot[None] * used[..., None]).any(1).sum(1))
     x[~good] = np.nan
-    vel, vcov = _velocity(t, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, e, el, used & good[:, None],
-                          sigma_doppler_m_per_s)
+    vel, vcov = _velocity(t, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, x[:, :3], e, el,
+                          used & good[:, None], sigma_doppler_m_per_s)
     lla = ecef_to_lla(x[:, :3])
     rot = ecef_to_enu_matrix(lla[:, 0], lla[:, 1])
     w_pos = np.einsum("mij,mjk,mlk->mil", rot, ninv[:, :3, :3], rot)
@@ -115,13 +116,15 @@ def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, grou
     return SppFixes(t, x[:, :3], vel_enu, w_pos, v_cov, x[:, 3:], names, np.where(good, n_used, 0))
 
 
-def _velocity(t, doppler, wavelength, sat, clk, e, el, used, sigma):
+def _velocity(t, doppler, wavelength, sat, clk, r, e, el, used, sigma):
     m, s = doppler.shape
     if m < 2:
         return np.full((m, 3), np.nan), np.full((m, 3, 3), np.nan)
-    vs = np.gradient(sat, t, axis=0)
-    clk_rate = np.gradient(clk, t, axis=0)
-    y = -np.asarray(wavelength, float)[None, :] * doppler + C_LIGHT * clk_rate - np.einsum("msj,msj->ms", e, vs)
+    vs = np.gradient(sat, t, axis=0, edge_order=2 if m > 2 else 1)
+    clk_rate = np.gradient(clk, t, axis=0, edge_order=2 if m > 2 else 1)
+    sagnac_rate = OMEGA_E * (vs[..., 0] * r[:, None, 1] - vs[..., 1] * r[:, None, 0]) / C_LIGHT
+    y = -np.asarray(wavelength, float)[None, :] * doppler + C_LIGHT * clk_rate - np.einsum("msj,msj->ms", e, vs) \
+        - sagnac_rate
     used = used & np.isfinite(y)
     a = np.concatenate([-e, np.ones((m, s, 1))], axis=-1)
     w = np.clip(np.sin(el), 0.1, 1.0) ** 2 / sigma**2
