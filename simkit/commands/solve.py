@@ -64,24 +64,42 @@ def _check(args, known):
     return filters
 
 
+def split_params(filters: list[str], params: dict) -> dict:
+    """Each filter's share of the ``--set`` keys: simkit.estimators filters take the keys they know; any other
+    filter (simkit.attitude) takes the keys none of those knows and checks them itself. A key no requested
+    filter can take is an error naming it."""
+    from ..estimators.registry import DEFAULTS, merged
+
+    ours = [n for n in filters if n in DEFAULTS]
+    known = set().union(*(DEFAULTS[n] for n in ours)) if ours else set()
+    if len(ours) == len(filters):
+        for key in params:
+            if key not in known:
+                merged(ours[0], {key: params[key]})  # raises, naming the key and the known ones
+    shares = {}
+    for name in filters:
+        if name in DEFAULTS:
+            shares[name] = {k: v for k, v in params.items() if k in DEFAULTS[name]}
+            merged(name, shares[name])
+        else:
+            shares[name] = {k: v for k, v in params.items() if k not in known}
+    return shares
+
+
 def run(args) -> int:
     from tqdm import tqdm
 
-    from ..estimators.registry import DEFAULTS, merged
     from ..io import open_dataset, write_solution
 
     known = registry()
     filters = _check(args, known)
-    params = parse_overrides(args.overrides)
-    for name in filters:
-        if name in DEFAULTS:
-            merged(name, params)  # unknown keys fail before any work
+    shares = split_params(filters, parse_overrides(args.overrides))
     open_dataset(args.file).close()
     bar = tqdm(total=len(filters), unit="filter", desc="solve", leave=False, disable=args.quiet)
     for name in filters:
         bar.set_postfix_str(name)
         with open_dataset(args.file) as ds:
-            sol = known[name](ds, params, not args.quiet)
+            sol = known[name](ds, shares[name], not args.quiet)
         write_solution(args.file, args.name or name, sol)
         bar.update()
         if not args.quiet:

@@ -30,13 +30,41 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER}, "hinf": {**COMMON
                      "lever_arm_error_m": [0.0, 0.0, 0.0]}}
 
 
+POSITIVE = {"sigma_code_m", "sigma_doppler_m_per_s", "truth_vel_sigma_m_per_s", "cov_dt_s", "p0_vel_m_per_s",
+            "pos_sigma_scale", "attitude_sigma_deg", "align_static_s", "p0_lever_m"}
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _check_value(key, default, value):
+    """The type of ``value`` matches the default's (numbers for None defaults); a few keys must be positive."""
+    if isinstance(default, bool) or isinstance(default, str):
+        ok = isinstance(value, type(default))
+        want = type(default).__name__
+    elif isinstance(default, list):
+        ok = isinstance(value, list) and len(value) == len(default) and all(map(_number, value))
+        want = f"a list of {len(default)} numbers"
+    else:
+        ok = _number(value)
+        want = "a number"
+    if not ok:
+        raise EstimatorInputError(f"estimator.{key}: expected {want}, got {value!r}")
+    if key in POSITIVE and not value > 0:
+        raise EstimatorInputError(f"estimator.{key}: expected a positive number, got {value!r}")
+    if key == "alpha" and not value > 1:
+        raise EstimatorInputError(f"estimator.alpha: expected > 1 (Wu 2015 uses 10), got {value!r}")
+
+
 def merged(name: str, params: dict) -> dict:
-    """Defaults of filter ``name`` overridden by ``params``; unknown keys raise naming the key."""
+    """Defaults of filter ``name`` overridden by ``params``; unknown keys or wrong types raise naming the key."""
     base = DEFAULTS[name]
-    for key in params:
+    for key, value in params.items():
         if key not in base:
             raise EstimatorInputError(f"estimator.{key}: unknown key for --filter {name} "
                                       f"(known: {', '.join(sorted(base))})")
+        _check_value(key, base[key], value)
     return {**base, **params}
 
 
@@ -44,15 +72,20 @@ def _system_of(sat_ids):
     return np.array([s[0] for s in sat_ids])
 
 
+def _antenna(ds, p) -> int:
+    a = int(p["antenna"])
+    n_ant = ds["gnss/antennas/lever_arm_b"].shape[0]
+    if not 0 <= a < n_ant:
+        raise EstimatorInputError(f"estimator.antenna: expected 0 .. {n_ant - 1}, got {a}")
+    return a
+
+
 def spp_fixes(ds, p):
     """Single-point fixes of antenna ``p['antenna']`` from /gnss/obs (first tracked signal per satellite)."""
     sat_ids = ds["gnss/sat_id"][:]
     signals, lam = list(ds["gnss/signals"][:]), ds["gnss/wavelength_m"][:]
     gd_all = ds["gnss/group_delay"][:]
-    a = int(p["antenna"])
-    n_ant = ds["gnss/antennas/lever_arm_b"].shape[0]
-    if not 0 <= a < n_ant:
-        raise EstimatorInputError(f"estimator.antenna: expected 0 .. {n_ant - 1}, got {a}")
+    a = _antenna(ds, p)
     code = doppler = None
     for j, sig in enumerate(signals):
         c = ds[f"gnss/obs/{sig}/code"][:, a, :]
@@ -96,7 +129,7 @@ def _truth_fixes(ds, p):
 
 
 def gnss_fixes(ds, p) -> GnssFixes:
-    lever = ds["gnss/antennas/lever_arm_b"][int(p["antenna"])]
+    lever = ds["gnss/antennas/lever_arm_b"][_antenna(ds, p)]
     if p["gnss"] == "truth":
         t, pos, vel, cp, cv = _truth_fixes(ds, p)
     elif p["gnss"] == "spp":
