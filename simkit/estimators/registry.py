@@ -40,6 +40,8 @@ def _number(x) -> bool:
 
 def _check_value(key, default, value):
     """The type of ``value`` matches the default's (numbers for None defaults); a few keys must be positive."""
+    if default is None and value is None:
+        return
     if isinstance(default, bool) or isinstance(default, str):
         ok = isinstance(value, type(default))
         want = type(default).__name__
