@@ -32,15 +32,23 @@ def cross(a, b):
 
 @njit(cache=True)
 def rotvec_matrix(v):
-    """exp([v x]) (Rodrigues), exact for any angle."""
-    th2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+    """exp([v x]) (Rodrigues: I + a [v x] + b [v x]^2), exact for any angle; written out element by element
+    (one allocation: this runs twice per IMU sample)."""
+    x, y, z = v[0], v[1], v[2]
+    th2 = x * x + y * y + z * z
     if th2 < 1e-12:
         a, b = 1.0 - th2 / 6.0, 0.5 - th2 / 24.0
     else:
         th = np.sqrt(th2)
         a, b = np.sin(th) / th, (1.0 - np.cos(th)) / th2
-    k = skew(v)
-    return np.eye(3) + a * k + b * (k @ k)
+    m = np.empty((3, 3))
+    m[0, 0] = 1.0 - b * (y * y + z * z)
+    m[1, 1] = 1.0 - b * (x * x + z * z)
+    m[2, 2] = 1.0 - b * (x * x + y * y)
+    m[0, 1], m[1, 0] = b * x * y - a * z, b * x * y + a * z
+    m[0, 2], m[2, 0] = b * x * z + a * y, b * x * z - a * y
+    m[1, 2], m[2, 1] = b * y * z - a * x, b * y * z + a * x
+    return m
 
 
 @njit(cache=True)

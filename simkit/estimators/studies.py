@@ -2,7 +2,8 @@
 
 ``drift FILE [--seconds S]``      strapdown on the error-free truth rates of FILE vs the truth
 ``badshah FILE [--plot OUT.png]`` kf21 with / without the GNSS attitude, 10 deg initial heading error
-``wu [--runs N]``                 KF vs H-infinity RMS per axis on high_dynamic with unmodelled coloured IMU noise
+``wu [--runs N] [--white]``       KF vs H-infinity RMS per axis on high_dynamic with unmodelled coloured IMU noise
+                                  (--white: the preset's own white noise and biases, which the filters model)
 ``pyins FILE``                    simkit kf15 and pyins' feedback filter on the same data (needs python-ins)
 Every study reads simkit files and prints JSON; nothing here is used by the filters themselves.
 """
@@ -110,8 +111,9 @@ def _rms_table(ds, sol, skip_s):
     return np.concatenate([r(dp), r(dv), np.degrees(r(de))])
 
 
-def wu(runs=10, seed0=1, workdir=None, skip_s=10.0) -> dict:
-    """Monte Carlo of KF vs H-infinity on high_dynamic with coloured IMU noise the filters do not model."""
+def wu(runs=10, seed0=1, workdir=None, skip_s=10.0, coloured=True) -> dict:
+    """Monte Carlo of KF vs H-infinity on high_dynamic with coloured IMU noise the filters do not model (or,
+    with ``coloured`` False, with the preset's white noise and turn-on biases, which they model exactly)."""
     from ..pipeline import run as simulate
 
     cols = ["pos_E_m", "pos_N_m", "pos_U_m", "vel_E_m_per_s", "vel_N_m_per_s", "vel_U_m_per_s", "pitch_deg",
@@ -119,7 +121,8 @@ def wu(runs=10, seed0=1, workdir=None, skip_s=10.0) -> dict:
     table = {"kf15": [], "hinf": []}
     with tempfile.TemporaryDirectory(dir=workdir) as d:
         for i in range(runs):
-            path = simulate("high_dynamic", out=Path(d) / f"hd{i}.h5", seed=seed0 + i, overrides=WU_COLOURED)
+            path = simulate("high_dynamic", out=Path(d) / f"hd{i}.h5", seed=seed0 + i,
+                              overrides=WU_COLOURED if coloured else [])
             with open_dataset(path) as ds:
                 for name in table:
                     sol = SOLVERS[name](ds, {**WU_GNSS, "seed": seed0 + i}, False)
@@ -127,7 +130,7 @@ def wu(runs=10, seed0=1, workdir=None, skip_s=10.0) -> dict:
     res = {name: dict(zip(cols, np.sqrt(np.mean(np.square(v), axis=0)).round(5).tolist()))
            for name, v in table.items()}
     res["hinf_over_kf"] = {c: round(res["hinf"][c] / res["kf15"][c], 3) for c in cols}
-    res["runs"] = runs
+    res["runs"], res["coloured_noise"] = runs, coloured
     return res
 
 
@@ -138,13 +141,14 @@ def main(argv=None):
     p.add_argument("--seconds", type=float)
     p.add_argument("--plot")
     p.add_argument("--runs", type=int, default=10)
+    p.add_argument("--white", action="store_true")
     a = p.parse_args(argv)
     if a.study == "drift":
         res = drift(a.file, a.seconds)
     elif a.study == "badshah":
         res = badshah(a.file, a.plot)
     elif a.study == "wu":
-        res = wu(a.runs)
+        res = wu(a.runs, coloured=not a.white)
     else:
         from .peer import compare_pyins
         res = compare_pyins(a.file)
