@@ -9,11 +9,12 @@ import time
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..frames import SWAP, attitude_from_ned_frd, attitude_to_ned_frd, euler_from_attitude, lla_to_ecef
+from ..frames import (SWAP, attitude_from_ned_frd, attitude_to_ned_frd, ecef_to_lla, euler_from_attitude,
+                      lla_to_ecef)
 from ..io import open_dataset
 from ..solution import Solution
+from .evaluate import rms_table
 from .registry import SOLVERS, filter_config, gnss_fixes, imu_data, initial_state, merged
-from .studies import _rms_table
 
 PARAMS = {"gnss": "truth", "truth_pos_sigma_m": [1.0, 1.0, 1.0], "truth_vel_sigma_m_per_s": 0.05,
           "align": "truth", "init_heading_error_deg": 2.0, "p0_att_deg": [1.0, 1.0, 3.0], "p0_pos_m": [2.0, 2.0, 2.0],
@@ -42,7 +43,6 @@ def pyins_inputs(ds, p):
     ve, vn, vu = init.vel_enu
     pva = pd.Series([np.degrees(lat), np.degrees(lon), h, vn, ve, -vu, *rph],
                     index=["lat", "lon", "alt", "VN", "VE", "VD", "roll", "pitch", "heading"], name=float(imu.t[0]))
-    from ..frames import ecef_to_lla
     lla = ecef_to_lla(gnss.pos_ecef)
     lever = SWAP @ gnss.lever_arm_b
     pos = _frame(gnss.t, np.column_stack([np.degrees(lla[:, 0]), np.degrees(lla[:, 1]), lla[:, 2]]),
@@ -87,8 +87,8 @@ def compare_pyins(path, skip_s=60.0) -> dict:
         wall_ours = time.perf_counter() - start
         theirs, wall_theirs = run_pyins(ds, p)
         n = ds["imu/t"].shape[0]
-        out = {"simkit_kf15": dict(zip(cols, _rms_table(ds, ours, skip_s).round(5).tolist())),
-               "pyins": dict(zip(cols, _rms_table(ds, theirs, skip_s).round(5).tolist()))}
+        out = {"simkit_kf15": dict(zip(cols, rms_table(ds, ours, skip_s).round(5).tolist())),
+               "pyins": dict(zip(cols, rms_table(ds, theirs, skip_s).round(5).tolist()))}
     out["wall_s"] = {"simkit_kf15 (incl. reading)": round(wall_ours, 2), "pyins filter": round(wall_theirs, 2)}
     out["imu_samples"] = int(n)
     return out

@@ -19,25 +19,13 @@ from scipy.spatial.transform import Rotation
 
 from ..frames import ecef_to_enu_vec
 from ..io import open_dataset
+from .evaluate import errors_vs_truth, rms_table
 from .registry import SOLVERS
 from .strapdown import strapdown
 
 WU_COLOURED = ["imu.gyro.gauss_markov=[{sigma_deg_per_h=0.5, tau_s=20.0}]",
                "imu.accel.gauss_markov=[{sigma_ug=200.0, tau_s=20.0}]"]
 WU_GNSS = {"gnss": "truth", "truth_pos_sigma_m": [0.1, 0.1, 0.1], "truth_vel_sigma_m_per_s": 0.01}
-
-
-def errors_vs_truth(ds, sol):
-    """Per-epoch errors of a solution: position ENU (m), velocity ENU (m/s), attitude [pitch, roll, heading]
-    differences (rad, wrapped), at the truth samples nearest the solution epochs."""
-    k = np.clip(np.searchsorted(ds["truth/t"][:], sol.t - 1e-9), 0, ds["truth/t"].shape[0] - 1)
-    lla = ds["truth/pos_lla"][:][k]
-    dp = ecef_to_enu_vec(sol.pos_ecef - ds["truth/pos_ecef"][:][k], lla[:, 0], lla[:, 1])
-    dv = sol.vel_enu - ds["truth/vel_enu"][:][k]
-    de = None
-    if sol.euler is not None:
-        de = (sol.euler - ds["truth/euler"][:][k] + np.pi) % (2 * np.pi) - np.pi
-    return dp, dv, de
 
 
 def drift(path, seconds=None) -> dict:
@@ -104,13 +92,6 @@ def _plot_heading(curves, out):
     plt.close(fig)
 
 
-def _rms_table(ds, sol, skip_s):
-    dp, dv, de = errors_vs_truth(ds, sol)
-    m = sol.t >= skip_s
-    r = lambda x: np.sqrt(np.mean(x[m] ** 2, axis=0))  # noqa: E731
-    return np.concatenate([r(dp), r(dv), np.degrees(r(de))])
-
-
 def wu(runs=10, seed0=1, workdir=None, skip_s=10.0, coloured=True) -> dict:
     """Monte Carlo of KF vs H-infinity on high_dynamic with coloured IMU noise the filters do not model (or,
     with ``coloured`` False, with the preset's white noise and turn-on biases, which they model exactly)."""
@@ -126,7 +107,7 @@ def wu(runs=10, seed0=1, workdir=None, skip_s=10.0, coloured=True) -> dict:
             with open_dataset(path) as ds:
                 for name in table:
                     sol = SOLVERS[name](ds, {**WU_GNSS, "seed": seed0 + i}, False)
-                    table[name].append(_rms_table(ds, sol, skip_s))
+                    table[name].append(rms_table(ds, sol, skip_s))
     res = {name: dict(zip(cols, np.sqrt(np.mean(np.square(v), axis=0)).round(5).tolist()))
            for name, v in table.items()}
     res["hinf_over_kf"] = {c: round(res["hinf"][c] / res["kf15"][c], 3) for c in cols}
