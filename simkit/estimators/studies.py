@@ -31,7 +31,7 @@ WU_GNSS = {"gnss": "truth", "truth_pos_sigma_m": [0.1, 0.1, 0.1], "truth_vel_sig
 def drift(path, seconds=None) -> dict:
     with open_dataset(path) as ds:
         t = ds["truth/t"][:]
-        n = t.size if seconds is None else int(np.searchsorted(t, seconds + 1e-9)) + 1
+        n = t.size if seconds is None else min(t.size, int(np.searchsorted(t, seconds + 1e-9)) + 1)
         sol = strapdown(t[:n], ds["truth/omega_ib_b"][:n], ds["truth/f_ib_b"][:n],
                         pos0_lla=ds["truth/pos_lla"][0], vel0_enu=ds["truth/vel_enu"][0],
                         quat0_nb=ds["truth/quat_nb"][0])
