@@ -32,7 +32,8 @@ class FilterConfig:
     ``accel_vrw`` m/s^2/sqrt(Hz); bias random walks ``gyro_bias_rw`` rad/s/sqrt(s), ``accel_bias_rw``
     m/s^2/sqrt(s); initial sigmas ``p0_att`` [pitch-ish E, N, U] rad, ``p0_vel`` m/s, ``p0_pos`` [E, N, U] m,
     ``p0_gyro_bias`` rad/s, ``p0_accel_bias`` m/s^2, ``p0_lever`` m (21 states); ``cov_dt`` s covariance step;
-    ``alpha`` H-infinity tuning (Wu 2015: 10); ``gyro_bias0``/``accel_bias0`` initial bias estimates (body)."""
+    ``alpha`` H-infinity tuning (Wu 2015: 10); ``gamma_rule``
+    "wu" (Wu's H^T H, with the weighted rule as fallback) or "weighted" (H^T R^-1 H); ``gyro_bias0``/``accel_bias0`` initial bias estimates (body)."""
 
     gyro_arw: float = 1e-4
     accel_vrw: float = 1e-3
@@ -48,6 +49,7 @@ class FilterConfig:
     alpha: float = 10.0
     gyro_bias0: tuple = (0.0, 0.0, 0.0)
     accel_bias0: tuple = (0.0, 0.0, 0.0)
+    gamma_rule: str = "wu"
 
 
 def _p0(cfg: FilterConfig, n: int, lat: float, h: float) -> np.ndarray:
@@ -132,8 +134,15 @@ class _LooselyCoupled:
         out = loop.allocate(idx.size, n)
         att_nis = np.full(aarr[0].size, np.nan)
         loop.run(phi, dvb, dt, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), garr, aarr,
-                 self.mode, float(cfg.alpha), out, att_nis)
+                 self._mode(), float(cfg.alpha), out, att_nis)
         return self._solution(imu.t[garr[0]], out, att_nis)
+
+    def _mode(self) -> int:
+        if self.mode == 0:
+            return 0
+        if self.config.gamma_rule not in ("wu", "weighted"):
+            raise EstimatorInputError(f"gamma_rule: expected 'wu' or 'weighted', got {self.config.gamma_rule!r}")
+        return 1 if self.config.gamma_rule == "wu" else 2
 
     def _solution(self, t, out, att_nis) -> Solution:
         c, v, pos, cov, bias, lever, gamma, margin, nis, w, status = out
@@ -141,7 +150,8 @@ class _LooselyCoupled:
         extras = {"gyro_bias": bias[:, :3], "accel_bias": bias[:, 3:], "lever_arm": lever, "nis": nis,
                   "innovation_std": w, "status": status}
         units = {"gyro_bias": "rad/s", "accel_bias": "m/s^2", "lever_arm": "m", "nis": "1",
-                 "innovation_std": "1", "status": "0 ok, 1 gamma raised, 2 S not positive definite"}
+                 "innovation_std": "1", "status": "0 ok, 1 gamma raised (Wu's rule violated the existence condition), 2 S not positive "
+                            "definite (update skipped)"}
         if self.mode == 1:
             extras.update(gamma=gamma, existence_margin=margin)
             units.update(gamma="1", existence_margin="SI (1/state^2)")

@@ -8,8 +8,10 @@ H-infinity (theta = gamma^-2):
          existence: P^-1 - theta I + H^T R^-1 H > 0 (its smallest eigenvalue is recorded as the margin);
          gamma adapts as in Wu 2015: gamma^2 = alpha * max eig((P^-1 + H^T H)^-1), alpha > 1.
          P+ = (P^-1 - theta I + H^T R^-1 H)^-1 is computed through the Cholesky factor of P (see _existence).
-         When the margin is not positive, theta is halved (gamma raised) until it is, and the status records
-         it: the condition is never violated silently.
+         Wu's gamma uses the unweighted H^T H, so it depends on the state and measurement units: when it violates
+         the condition (e.g. a height fix of 5 m sigma, R > 1), gamma is raised to the weighted rule
+         theta = 1 / (alpha max eig((P^-1 + H^T R^-1 H)^-1)) (then halved further if ever needed), and the
+         status records it: the condition is never violated silently.
 """
 from __future__ import annotations
 
@@ -79,31 +81,42 @@ def _existence(l, h, r_inv, theta):
 
 
 @njit(cache=True)
-def correct_hinf(x, p, nu, h, r, alpha):
+def weighted_theta(p, h, r, alpha):
+    """theta = 1 / (alpha * max eig((P^-1 + H^T R^-1 H)^-1)): Wu's rule with the measurement weighting (the
+    inverse is the Kalman posterior covariance, formed in Joseph form). The existence matrix then stays
+    positive definite by construction, and no direction of P grows by more than alpha / (alpha - 1) per update."""
+    _, p_kf, _, _, status = correct(np.zeros(p.shape[0]), p, np.zeros(h.shape[0]), h, r)
+    if status != STATUS_OK:
+        return np.nan
+    return 1.0 / (alpha * np.linalg.eigvalsh(p_kf)[-1])
+
+
+@njit(cache=True)
+def correct_hinf(x, p, nu, h, r, alpha, weighted=False):
     """H-infinity correction. Returns (x, P, nis, w, gamma, margin, status); see the module docstring. The
-    margin is the smallest eigenvalue of the congruent, dimensionless form of the existence matrix."""
+    margin is the smallest eigenvalue of the congruent, dimensionless form of the existence matrix. With
+    ``weighted`` the gamma rule uses H^T R^-1 H instead of Wu's H^T H (see :func:`weighted_theta`)."""
     l = _chol(p)
-    s = h @ p @ h.T + r
-    ls = _chol(s)
+    ls = _chol(h @ p @ h.T + r)
     if l.shape[0] == 0 or ls.shape[0] == 0:
         return x, p, np.nan, np.full(nu.size, np.nan), np.nan, np.nan, STATUS_S_NOT_PD
     r_inv = np.linalg.inv(r)
-    gamma = hinf_gamma(p, h, alpha)
-    theta = 1.0 / gamma**2
-    e = _existence(l, h, r_inv, theta)
-    margin = np.linalg.eigvalsh(e)[0]
+    theta = weighted_theta(p, h, r, alpha) if weighted else 1.0 / hinf_gamma(p, h, alpha) ** 2
+    margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
     status = STATUS_OK
-    while not margin > 0.0 and theta > 1e-300:
-        theta *= 0.5
-        e = _existence(l, h, r_inv, theta)
-        margin = np.linalg.eigvalsh(e)[0]
+    if not margin > 0.0:  # Wu's rule violated the condition: fall back to the weighted rule, then halve theta
         status = STATUS_GAMMA_RAISED
-    gamma = 1.0 / np.sqrt(theta)
+        theta = weighted_theta(p, h, r, alpha)
+        margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
+        while not margin > 0.0 and theta > 1e-300:
+            theta *= 0.5
+            margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
+    e = _existence(l, h, r_inv, theta)
     p_new = l @ np.linalg.solve(e, l.T)
     p_new = 0.5 * (p_new + p_new.T)
     k = p_new @ h.T @ r_inv
     w = np.linalg.solve(ls, nu)
-    return x + k @ nu, p_new, np.sum(w * w), w, gamma, margin, status
+    return x + k @ nu, p_new, np.sum(w * w), w, 1.0 / np.sqrt(theta), margin, status
 
 
 @dataclass(frozen=True)

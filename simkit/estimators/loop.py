@@ -1,6 +1,7 @@
 """The filter recursion (numba): strapdown at the IMU rate, covariance propagation every ``cov_dt`` s and before
 each update, loosely coupled position/velocity updates at the GNSS epochs, GNSS attitude updates, closed-loop
-feedback (the error state is reset to zero after each correction). ``mode`` 0 = Kalman, 1 = H-infinity."""
+feedback (the error state is reset to zero after each correction). ``mode`` 0 = Kalman, 1 = H-infinity with Wu's
+gamma rule, 2 = H-infinity with the weighted gamma rule."""
 from __future__ import annotations
 
 import numpy as np
@@ -24,8 +25,8 @@ def _feedback(x, c, v, pos, bg, ba, lever):
 @njit(cache=True)
 def _update(p, nu, h, r, mode, alpha):
     x = np.zeros(p.shape[0])
-    if mode == 1:
-        return kalman.correct_hinf(x, p, nu, h, r, alpha)
+    if mode >= 1:
+        return kalman.correct_hinf(x, p, nu, h, r, alpha, mode == 2)
     x, p, nis, w, status = kalman.correct(x, p, nu, h, r)
     return x, p, nis, w, np.nan, np.nan, status
 

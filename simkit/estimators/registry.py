@@ -25,7 +25,7 @@ FILTER = {"align": "motion", "align_static_s": 10.0, "init_heading_error_deg": 0
           "p0_vel_m_per_s": 0.5, "p0_pos_m": [5.0, 5.0, 10.0], "gyro_arw": None, "accel_vrw": None,
           "gyro_bias_rw": None, "accel_bias_rw": None, "p0_gyro_bias": None, "p0_accel_bias": None,
           "cov_dt_s": 0.1, "pos_sigma_scale": 1.0}
-DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER}, "hinf": {**COMMON, **FILTER, "alpha": 10.0},
+DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER}, "hinf": {**COMMON, **FILTER, "alpha": 10.0, "gamma_rule": "wu"},
             "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.5,
                      "lever_arm_error_m": [0.0, 0.0, 0.0]}}
 
@@ -55,6 +55,8 @@ def _check_value(key, default, value):
         raise EstimatorInputError(f"estimator.{key}: expected {want}, got {value!r}")
     if key in POSITIVE and not value > 0:
         raise EstimatorInputError(f"estimator.{key}: expected a positive number, got {value!r}")
+    if key == "gamma_rule" and value not in ("wu", "weighted"):
+        raise EstimatorInputError(f"estimator.gamma_rule: expected 'wu' or 'weighted', got {value!r}")
     if key == "alpha" and not value > 1:
         raise EstimatorInputError(f"estimator.alpha: expected > 1 (Wu 2015 uses 10), got {value!r}")
 
@@ -172,7 +174,8 @@ def filter_config(ds, p, name) -> FilterConfig:
         p0_accel_bias=pick("p0_accel_bias", max(m["accel"][1] + m["accel"][3], 1e-5)),
         p0_att=tuple(np.radians(np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3))),
         p0_vel=float(p["p0_vel_m_per_s"]), p0_pos=tuple(np.broadcast_to(np.asarray(p["p0_pos_m"], float), 3)),
-        p0_lever=float(p.get("p0_lever_m", 0.5)), cov_dt=float(p["cov_dt_s"]), alpha=float(p.get("alpha", 10.0)))
+        p0_lever=float(p.get("p0_lever_m", 0.5)), cov_dt=float(p["cov_dt_s"]), alpha=float(p.get("alpha", 10.0)),
+        gamma_rule=str(p.get("gamma_rule", "wu")))
 
 
 def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
