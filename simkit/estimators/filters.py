@@ -5,7 +5,8 @@ Each has ``run(imu, gnss, attitude=None) -> Solution`` on numpy arrays (``ImuDat
 position, velocity, attitude, the error-state covariance (``cov``, in the order of ``state_names``, SI units:
 rad, m/s, rad, rad, m, rad/s, m/s^2, m), and extras: ``gyro_bias`` (rad/s), ``accel_bias`` (m/s^2),
 ``lever_arm`` (m), ``nis`` and ``innovation_std`` (standardised position/velocity innovations), ``status``,
-and for H-infinity ``gamma`` and ``existence_margin`` (smallest eigenvalue of P^-1 - theta I + H^T R^-1 H).
+and for H-infinity ``gamma`` and ``existence_margin`` (smallest eigenvalue of the existence matrix in the
+congruent form L^T (P^-1 - theta I + H^T R^-1 H) L, P = L L^T: dimensionless, positive whenever it exists).
 """
 from __future__ import annotations
 
@@ -33,7 +34,8 @@ class FilterConfig:
     m/s^2/sqrt(s); initial sigmas ``p0_att`` [pitch-ish E, N, U] rad, ``p0_vel`` m/s, ``p0_pos`` [E, N, U] m,
     ``p0_gyro_bias`` rad/s, ``p0_accel_bias`` m/s^2, ``p0_lever`` m (21 states); ``cov_dt`` s covariance step;
     ``alpha`` H-infinity tuning (Wu 2015: 10); ``gamma_rule``
-    "wu" (Wu's H^T H, with the weighted rule as fallback) or "weighted" (H^T R^-1 H); ``gyro_bias0``/``accel_bias0`` initial bias estimates (body)."""
+    "wu" (Wu's H^T H, with the weighted rule as fallback) or "weighted" (H^T R^-1 H);
+    ``gyro_bias0``/``accel_bias0`` initial bias estimates (body)."""
 
     gyro_arw: float = 1e-4
     accel_vrw: float = 1e-3
@@ -150,11 +152,12 @@ class _LooselyCoupled:
         extras = {"gyro_bias": bias[:, :3], "accel_bias": bias[:, 3:], "lever_arm": lever, "nis": nis,
                   "innovation_std": w, "status": status}
         units = {"gyro_bias": "rad/s", "accel_bias": "m/s^2", "lever_arm": "m", "nis": "1",
-                 "innovation_std": "1", "status": "0 ok, 1 gamma raised (Wu's rule violated the existence condition), 2 S not positive "
-                            "definite (update skipped)"}
+                 "innovation_std": "1",
+                 "status": "0 ok, 1 gamma raised (Wu's rule violated the existence condition), "
+                           "2 S not positive definite (update skipped)"}
         if self.mode == 1:
             extras.update(gamma=gamma, existence_margin=margin)
-            units.update(gamma="1", existence_margin="SI (1/state^2)")
+            units.update(gamma="1", existence_margin="1 (smallest eigenvalue of L^T (P^-1 - theta I + H^T R^-1 H) L, P = L L^T)")
         config = {"estimator": self.name, **asdict(self.config)}
         if att_nis.size:
             config["attitude_nis_mean"] = float(np.nanmean(att_nis))

@@ -25,7 +25,8 @@ FILTER = {"align": "motion", "align_static_s": 10.0, "init_heading_error_deg": 0
           "p0_vel_m_per_s": 0.5, "p0_pos_m": [5.0, 5.0, 10.0], "gyro_arw": None, "accel_vrw": None,
           "gyro_bias_rw": None, "accel_bias_rw": None, "p0_gyro_bias": None, "p0_accel_bias": None,
           "cov_dt_s": 0.1, "pos_sigma_scale": 1.0}
-DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER}, "hinf": {**COMMON, **FILTER, "alpha": 10.0, "gamma_rule": "wu"},
+DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
+            "hinf": {**COMMON, **FILTER, "alpha": 10.0, "gamma_rule": "wu"},
             "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.5,
                      "lever_arm_error_m": [0.0, 0.0, 0.0]}}
 
