@@ -157,7 +157,8 @@ class _LooselyCoupled:
                            "2 S not positive definite (update skipped)"}
         if self.mode == 1:
             extras.update(gamma=gamma, existence_margin=margin)
-            units.update(gamma="1", existence_margin="1 (smallest eigenvalue of L^T (P^-1 - theta I + H^T R^-1 H) L, P = L L^T)")
+            units.update(gamma="1", existence_margin="1 (smallest eigenvalue of L^T (P^-1 - theta I + H^T R^-1 H) L, "
+                                                    "P = L L^T)")
         config = {"estimator": self.name, **asdict(self.config)}
         if att_nis.size:
             config["attitude_nis_mean"] = float(np.nanmean(att_nis))
