@@ -122,10 +122,16 @@ class _LooselyCoupled:
     def run(self, imu: ImuData, gnss: GnssFixes, attitude: AttitudeFixes | None = None,
             init: InitialState | None = None) -> Solution:
         """Filter ``imu`` with ``gnss`` fixes (and ``attitude`` fixes, used by the 21-state filter). ``init``
-        (or the constructor's) is the navigation state at the first IMU sample."""
+        (or the constructor's) is the navigation state at ``init.t``, an IMU sample time: earlier samples are
+        not used."""
         init = init or self.init
         if init is None:
             raise EstimatorInputError(f"{self.name}.run: an InitialState is needed (see simkit.estimators.align)")
+        k0 = int(np.searchsorted(imu.t, init.t - 1e-9))
+        if k0 >= imu.t.size - 1:
+            raise EstimatorInputError(f"{self.name}.run: init.t = {init.t} s is after the IMU data")
+        if k0 > 0:  # start at the initial state's epoch (row k0 of increments covers the interval before it)
+            imu = ImuData(imu.t[k0:], imu.gyro[k0:], imu.accel[k0:], imu.increments)
         phi, dvb, dt = (from_increments if imu.increments else from_rates)(imu.t, imu.gyro, imu.accel)
         cfg, n = self.config, self.n_states
         pos0 = np.asarray(init.pos_lla, float)

@@ -180,9 +180,9 @@ def filter_config(ds, p, name) -> FilterConfig:
 
 
 def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
-    """Navigation state at the first IMU sample from ``p['align']``: 'static' (levelling + gyrocompassing over
-    the first align_static_s), 'motion' (GNSS velocity), 'truth' (the file's truth, a study mode), plus
-    ``init_heading_error_deg``."""
+    """Initial navigation state from ``p['align']``: 'static' (levelling + gyrocompassing over the first
+    align_static_s; at the first IMU sample), 'motion' (from the first GNSS fix faster than 5 m/s, at its epoch),
+    'truth' (the file's truth at the first sample, a study mode), plus ``init_heading_error_deg``."""
     good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
     if good.size == 0:
         raise EstimatorInputError(f"{ds.path}: no GNSS fix to initialise the position from")
@@ -201,12 +201,15 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
             moving = good[np.hypot(gnss.vel_enu[good, 0], gnss.vel_enu[good, 1]) > 5.0]
             if moving.size == 0:
                 raise EstimatorInputError("estimator.align: 'motion' needs a GNSS speed above 5 m/s; try 'static'")
-            euler, vel = motion_alignment(gnss.vel_enu[moving[0]]), gnss.vel_enu[moving[0]]
+            g0 = moving[0]
+            euler, vel = motion_alignment(gnss.vel_enu[g0]), gnss.vel_enu[g0]
+            lla_ant = ecef_to_lla(gnss.pos_ecef[g0])
         lla = lla_ant  # the lever arm (metres) is left to the filter's position uncertainty
     else:
         raise EstimatorInputError(f"estimator.align: expected 'static', 'motion' or 'truth', got {p['align']!r}")
     euler = np.asarray(euler, float) + [0.0, 0.0, np.radians(float(p["init_heading_error_deg"]))]
-    return InitialState(float(imu.t[0]), np.asarray(lla, float), np.asarray(vel, float), quat_from_euler(*euler))
+    t0 = float(gnss.t[g0]) if p["align"] == "motion" else float(imu.t[0])
+    return InitialState(t0, np.asarray(lla, float), np.asarray(vel, float), quat_from_euler(*euler))
 
 
 def _attitude(ds, p) -> AttitudeFixes:
