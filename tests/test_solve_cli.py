@@ -74,3 +74,29 @@ def test_help_lists_the_options(tmp_path):
     proc = run_cli(["solve", "--help"], tmp_path)
     assert proc.returncode == 0 and "--filter" in proc.stdout and "--set" in proc.stdout
     assert json.dumps  # the config attribute is JSON: read back above through read_solution
+
+
+def test_attitude_solvers_are_merged_and_get_the_keys_no_estimator_knows(small, monkeypatch):
+    import importlib.machinery
+    import sys
+    import types
+
+    from simkit.solution import Solution
+
+    seen = {}
+
+    def fake(ds, params, progress):
+        seen.update(params)
+        t = ds["gnss/t"][:]
+        return Solution(t=t, euler=np.zeros((t.size, 3)), config={"estimator": "fake"})
+
+    module = types.ModuleType("simkit.attitude")
+    module.__spec__ = importlib.machinery.ModuleSpec("simkit.attitude", None)
+    module.SOLVERS = {"fake_attitude": fake}
+    monkeypatch.setitem(sys.modules, "simkit.attitude", module)
+    proc = run_cli(["solve", str(small), "--filter", "fake_attitude", "--filter", "spp", "--set",
+                    "estimator.baseline_m=3.5", "--set", "estimator.elevation_mask_deg=15.0", "-q"], small.parent)
+    assert proc.returncode == 0, proc.stderr
+    assert seen == {"baseline_m": 3.5}
+    assert read_solution(small, "spp").config["elevation_mask_deg"] == 15.0
+    assert "fake_attitude" in solution_names(small)
