@@ -15,7 +15,7 @@ import sys
 from .errors import SimkitError
 from .version import __version__
 
-COMMANDS = ("run", "inspect", "allan", "sky", "rinex", "validate", "campaign", "score", "regress", "plot")
+COMMANDS = ("run", "inspect", "solve", "validate", "score", "plot", "regress", "campaign", "allan", "sky", "rinex")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -1,0 +1,44 @@
+"""Filter consistency against truth: the error state in the filter's own definitions, NEES and its chi^2 bounds.
+
+Error state (computed minus true, see :mod:`.model`): phi from C~ C^T = I - [phi x], dv = v~ - v,
+dp = [L~ - L, lambda~ - lambda, h~ - h], and for the sensor states the residual error left after the filter's
+compensation (true bias minus estimated bias), lever-arm estimate minus the true lever arm.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+from scipy.stats import chi2
+
+from ..frames import ecef_to_lla
+from ..solution import Solution
+
+
+def error_states(sol: Solution, quat_nb, vel_enu, pos_lla, gyro_bias=None, accel_bias=None, lever_arm=None):
+    """(K, X) error states of ``sol`` given the truth at its epochs: ``quat_nb`` (K, 4), ``vel_enu`` (K, 3),
+    ``pos_lla`` (K, 3), and optionally the true sensor biases (K, 3) rad/s, m/s^2 and lever arm (3,) m."""
+    n = len(sol.state_names)
+    e = np.zeros((sol.t.size, n))
+    d = Rotation.from_quat(sol.quat_nb) * Rotation.from_quat(quat_nb).inv()  # C~ C^T = exp(-[phi x])
+    e[:, 0:3] = -d.as_rotvec()
+    e[:, 3:6] = sol.vel_enu - vel_enu
+    lla = ecef_to_lla(sol.pos_ecef)
+    e[:, 6:9] = lla - pos_lla
+    e[:, 7] = (e[:, 7] + np.pi) % (2 * np.pi) - np.pi
+    if n >= 15:
+        e[:, 9:12] = (gyro_bias if gyro_bias is not None else 0.0) - sol.extras["gyro_bias"]
+        e[:, 12:15] = (accel_bias if accel_bias is not None else 0.0) - sol.extras["accel_bias"]
+    if n >= 18:
+        e[:, 15:18] = sol.extras["lever_arm"] - (lever_arm if lever_arm is not None else 0.0)
+    return e
+
+
+def nees(errors, cov):
+    """Normalised estimation error squared e^T P^-1 e per epoch, (K,)."""
+    return np.einsum("ki,ki->k", errors, np.linalg.solve(cov, errors[..., None])[..., 0])
+
+
+def chi2_bounds(dof: int, runs: int, level: float = 0.95):
+    """Two-sided bounds of the average of ``runs`` independent chi^2(dof) values."""
+    a = (1.0 - level) / 2.0
+    return chi2.ppf(a, dof * runs) / runs, chi2.ppf(1.0 - a, dof * runs) / runs

@@ -1,0 +1,193 @@
+"""Loosely coupled INS/GNSS filters: :class:`KalmanFilter15`, :class:`KalmanFilter21`, :class:`HInfinityFilter`.
+
+Each has ``run(imu, gnss, attitude=None) -> Solution`` on numpy arrays (``ImuData``, ``GnssFixes``,
+``AttitudeFixes``), no file involved. The solution has one epoch per GNSS fix used (after its update): IMU-centre
+position, velocity, attitude, the error-state covariance (``cov``, in the order of ``state_names``, SI units:
+rad, m/s, rad, rad, m, rad/s, m/s^2, m), and extras: ``gyro_bias`` (rad/s), ``accel_bias`` (m/s^2),
+``lever_arm`` (m), ``nis`` and ``innovation_std`` (standardised position/velocity innovations), ``status``,
+and for H-infinity ``gamma`` and ``existence_margin`` (smallest eigenvalue of the existence matrix in the
+congruent form L^T (P^-1 - theta I + H^T R^-1 H) L, P = L L^T: dimensionless, positive whenever it exists).
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..frames import ecef_to_lla, euler_from_attitude, lla_to_ecef
+from ..solution import Solution
+from . import loop, model
+from .errors import EstimatorInputError
+from .increments import from_increments, from_rates
+from .inputs import AttitudeFixes, GnssFixes, ImuData, InitialState
+
+STATE_NAMES = ("phi_e", "phi_n", "phi_u", "dv_e", "dv_n", "dv_u", "d_lat", "d_lon", "d_h",
+               "gyro_bias_x", "gyro_bias_y", "gyro_bias_z", "accel_bias_x", "accel_bias_y", "accel_bias_z",
+               "lever_x", "lever_y", "lever_z")
+
+
+@dataclass(frozen=True)
+class FilterConfig:
+    """Noise model and initial uncertainty (SI). White noise densities: ``gyro_arw`` rad/s/sqrt(Hz),
+    ``accel_vrw`` m/s^2/sqrt(Hz); bias random walks ``gyro_bias_rw`` rad/s/sqrt(s), ``accel_bias_rw``
+    m/s^2/sqrt(s); initial sigmas ``p0_att`` [pitch-ish E, N, U] rad, ``p0_vel`` m/s, ``p0_pos`` [E, N, U] m,
+    ``p0_gyro_bias`` rad/s, ``p0_accel_bias`` m/s^2, ``p0_lever`` m (21 states); ``cov_dt`` s covariance step;
+    ``alpha`` H-infinity tuning (Wu 2015: 10); ``gamma_rule``
+    "wu" (Wu's H^T H, with the weighted rule as fallback) or "weighted" (H^T R^-1 H);
+    ``gyro_bias0``/``accel_bias0`` initial bias estimates (body)."""
+
+    gyro_arw: float = 1e-4
+    accel_vrw: float = 1e-3
+    gyro_bias_rw: float = 0.0
+    accel_bias_rw: float = 0.0
+    p0_att: tuple = (0.01, 0.01, 0.1)
+    p0_vel: float = 0.1
+    p0_pos: tuple = (5.0, 5.0, 10.0)
+    p0_gyro_bias: float = 1e-4
+    p0_accel_bias: float = 1e-2
+    p0_lever: float = 0.5
+    cov_dt: float = 0.1
+    alpha: float = 10.0
+    gyro_bias0: tuple = (0.0, 0.0, 0.0)
+    accel_bias0: tuple = (0.0, 0.0, 0.0)
+    gamma_rule: str = "wu"
+
+
+def _p0(cfg: FilterConfig, n: int, lat: float, h: float) -> np.ndarray:
+    tp = model.enu_to_geodetic(lat, h)
+    sig = np.zeros(n)
+    sig[0:3] = np.broadcast_to(cfg.p0_att, 3)
+    sig[3:6] = cfg.p0_vel
+    sig[9:12] = cfg.p0_gyro_bias
+    sig[12:15] = cfg.p0_accel_bias
+    if n > 15:
+        sig[15:18] = cfg.p0_lever
+    p = np.diag(sig**2)
+    p[6:9, 6:9] = tp @ np.diag(np.broadcast_to(cfg.p0_pos, 3) ** 2.0) @ tp.T
+    return p
+
+
+def _qc(cfg: FilterConfig, n: int) -> np.ndarray:
+    q = np.zeros(n)
+    q[0:3], q[3:6] = cfg.gyro_arw**2, cfg.accel_vrw**2
+    q[9:12], q[12:15] = cfg.gyro_bias_rw**2, cfg.accel_bias_rw**2
+    return q
+
+
+def sample_index(t_imu: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Index of the IMU sample at each time of ``t`` (within half an IMU interval), -1 where none (or t[0])."""
+    j = np.clip(np.searchsorted(t_imu, t), 1, t_imu.size - 1)
+    j = np.where(np.abs(t_imu[j - 1] - t) < np.abs(t_imu[j] - t), j - 1, j)
+    half = 0.5 * np.median(np.diff(t_imu))
+    ok = (np.abs(t_imu[j] - t) <= half + 1e-9) & (j > 0)
+    return np.where(ok, j, -1)
+
+
+def _gnss_arrays(gnss: GnssFixes, t_imu):
+    lla = ecef_to_lla(gnss.pos_ecef)
+    k = sample_index(t_imu, gnss.t)
+    good = (k > 0) & np.isfinite(lla).all(1) & np.isfinite(gnss.vel_enu).all(1)
+    good &= np.concatenate([[True], np.diff(k) > 0])
+    idx = np.flatnonzero(good)
+    z = np.concatenate([lla[idx], gnss.vel_enu[idx]], axis=1)
+    r = np.zeros((idx.size, 6, 6))
+    for j, i in enumerate(idx):
+        tp = model.enu_to_geodetic(lla[i, 0], lla[i, 2])
+        r[j, 0:3, 0:3] = tp @ gnss.pos_cov_enu[i] @ tp.T
+        r[j, 3:6, 3:6] = gnss.vel_cov_enu[i]
+    return idx, (k[idx].astype(np.int64), z, r)
+
+
+def _att_arrays(att: AttitudeFixes | None, t_imu):
+    if att is None:
+        return (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3, 3)))
+    k = sample_index(t_imu, att.t)
+    good = (k > 0) & np.isfinite(att.euler).all(1)
+    good &= np.concatenate([[True], np.diff(k) > 0])
+    return (k[good].astype(np.int64), att.euler[good], att.cov[good])
+
+
+class _LooselyCoupled:
+    """Shared machinery; subclasses fix the state count and the update (Kalman or H-infinity)."""
+
+    n_states = 15
+    mode = 0
+    name = "kf15"
+
+    def __init__(self, config: FilterConfig | None = None, init: InitialState | None = None):
+        self.config = config or FilterConfig()
+        self.init = init
+
+    def run(self, imu: ImuData, gnss: GnssFixes, attitude: AttitudeFixes | None = None,
+            init: InitialState | None = None) -> Solution:
+        """Filter ``imu`` with ``gnss`` fixes (and ``attitude`` fixes, used by the 21-state filter). ``init``
+        (or the constructor's) is the navigation state at ``init.t``, an IMU sample time: earlier samples are
+        not used."""
+        init = init or self.init
+        if init is None:
+            raise EstimatorInputError(f"{self.name}.run: an InitialState is needed (see simkit.estimators.align)")
+        k0 = int(np.searchsorted(imu.t, init.t - 1e-9))
+        if k0 >= imu.t.size - 1:
+            raise EstimatorInputError(f"{self.name}.run: init.t = {init.t} s is after the IMU data")
+        if k0 > 0:  # start at the initial state's epoch (row k0 of increments covers the interval before it)
+            imu = ImuData(imu.t[k0:], imu.gyro[k0:], imu.accel[k0:], imu.increments)
+        phi, dvb, dt = (from_increments if imu.increments else from_rates)(imu.t, imu.gyro, imu.accel)
+        cfg, n = self.config, self.n_states
+        pos0 = np.asarray(init.pos_lla, float)
+        nav0 = (Rotation.from_quat(init.quat_nb).as_matrix(), np.asarray(init.vel_enu, float), pos0,
+                np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy())
+        idx, garr = _gnss_arrays(gnss, imu.t)
+        aarr = _att_arrays(attitude if n > 15 else None, imu.t)
+        out = loop.allocate(idx.size, n)
+        att_nis = np.full(aarr[0].size, np.nan)
+        loop.run(phi, dvb, dt, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), garr, aarr,
+                 self._mode(), float(cfg.alpha), out, att_nis)
+        return self._solution(imu.t[garr[0]], out, att_nis)
+
+    def _mode(self) -> int:
+        if self.mode == 0:
+            return 0
+        if self.config.gamma_rule not in ("wu", "weighted"):
+            raise EstimatorInputError(f"gamma_rule: expected 'wu' or 'weighted', got {self.config.gamma_rule!r}")
+        return 1 if self.config.gamma_rule == "wu" else 2
+
+    def _solution(self, t, out, att_nis) -> Solution:
+        c, v, pos, cov, bias, lever, gamma, margin, nis, w, status = out
+        rot = Rotation.from_matrix(c)
+        extras = {"gyro_bias": bias[:, :3], "accel_bias": bias[:, 3:], "lever_arm": lever, "nis": nis,
+                  "innovation_std": w, "status": status}
+        units = {"gyro_bias": "rad/s", "accel_bias": "m/s^2", "lever_arm": "m", "nis": "1",
+                 "innovation_std": "1",
+                 "status": "0 ok, 1 gamma raised (Wu's rule violated the existence condition), "
+                           "2 S not positive definite (update skipped)"}
+        if self.mode == 1:
+            extras.update(gamma=gamma, existence_margin=margin)
+            units.update(gamma="1", existence_margin="1 (smallest eigenvalue of L^T (P^-1 - theta I + H^T R^-1 H) L, "
+                                                    "P = L L^T)")
+        config = {"estimator": self.name, **asdict(self.config)}
+        if att_nis.size:
+            config["attitude_nis_mean"] = float(np.nanmean(att_nis))
+        return Solution(t=t, pos_ecef=lla_to_ecef(pos[:, 0], pos[:, 1], pos[:, 2]), vel_enu=v,
+                        quat_nb=rot.as_quat(), euler=euler_from_attitude(rot), cov=cov,
+                        state_names=STATE_NAMES[:self.n_states], extras=extras, extra_units=units, config=config)
+
+
+class KalmanFilter15(_LooselyCoupled):
+    """15-state loosely coupled error-state Kalman filter (Wu 2015 eqs 1-16), closed loop, lever arm known."""
+
+
+class KalmanFilter21(_LooselyCoupled):
+    """Badshah 2015's "21-state" filter: the 15 states plus the lever arm (body, m) as a state, and GNSS
+    attitude fixes when given. The paper's own state list (attitude, velocity, position, gyro drift, accel bias,
+    lever arm: 6 x 3) has 18 entries, so the solution carries 18 states; the name follows the paper."""
+
+    n_states = 18
+    name = "kf21"
+
+
+class HInfinityFilter(_LooselyCoupled):
+    """15-state H-infinity filter (Wu 2015 eq 17, Simon's form, theta = gamma^-2, adaptive gamma, alpha)."""
+
+    mode = 1
+    name = "hinf"

@@ -1,0 +1,241 @@
+"""``simkit solve`` entries: ``SOLVERS[name](ds, params, progress) -> Solution`` for spp, kf15, kf21, hinf.
+
+``params`` are ``--set estimator.key=value`` overrides over ``DEFAULTS`` (an unknown key is an error naming it).
+Noise defaults come from the file's ``/imu`` model attributes (white noise, turn-on bias, rate random walk), so
+a filter run on simulated data is tuned to the simulated IMU unless told otherwise.
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..frames import ecef_to_lla, enu_to_ecef_vec, ecef_to_enu_vec, quat_from_euler
+from ..solution import Solution
+from .align import motion_alignment, static_alignment
+from .errors import EstimatorInputError
+from .filters import FilterConfig, HInfinityFilter, KalmanFilter15, KalmanFilter21
+from .inputs import AttitudeFixes, GnssFixes, ImuData, InitialState
+from .spp import spp
+
+COMMON = {"gnss": "spp", "antenna": 0, "elevation_mask_deg": 10.0, "sigma_code_m": 3.0,
+          "sigma_doppler_m_per_s": 0.1, "truth_pos_sigma_m": [1.0, 1.0, 5.0], "truth_vel_sigma_m_per_s": 0.05,
+          "seed": 0}
+FILTER = {"align": "motion", "align_static_s": 10.0, "init_heading_error_deg": 0.0, "p0_att_deg": [1.0, 1.0, 10.0],
+          "p0_vel_m_per_s": 0.5, "p0_pos_m": [5.0, 5.0, 10.0], "gyro_arw": None, "accel_vrw": None,
+          "gyro_bias_rw": None, "accel_bias_rw": None, "p0_gyro_bias": None, "p0_accel_bias": None,
+          "cov_dt_s": 0.1, "pos_sigma_scale": 1.0}
+DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
+            "hinf": {**COMMON, **FILTER, "alpha": 10.0, "gamma_rule": "wu"},
+            "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.5,
+                     "lever_arm_error_m": [0.0, 0.0, 0.0]}}
+
+
+POSITIVE = {"sigma_code_m", "sigma_doppler_m_per_s", "truth_vel_sigma_m_per_s", "cov_dt_s", "p0_vel_m_per_s",
+            "pos_sigma_scale", "attitude_sigma_deg", "align_static_s", "p0_lever_m"}
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _check_value(key, default, value):
+    """The type of ``value`` matches the default's (numbers for None defaults); a few keys must be positive."""
+    if default is None and value is None:
+        return
+    if isinstance(default, bool) or isinstance(default, str):
+        ok = isinstance(value, type(default))
+        want = type(default).__name__
+    elif isinstance(default, list):
+        ok = isinstance(value, list) and len(value) == len(default) and all(map(_number, value))
+        want = f"a list of {len(default)} numbers"
+    else:
+        ok = _number(value)
+        want = "a number"
+    if not ok:
+        raise EstimatorInputError(f"estimator.{key}: expected {want}, got {value!r}")
+    if key in POSITIVE and not value > 0:
+        raise EstimatorInputError(f"estimator.{key}: expected a positive number, got {value!r}")
+    if key == "gamma_rule" and value not in ("wu", "weighted"):
+        raise EstimatorInputError(f"estimator.gamma_rule: expected 'wu' or 'weighted', got {value!r}")
+    if key == "alpha" and not value > 1:
+        raise EstimatorInputError(f"estimator.alpha: expected > 1 (Wu 2015 uses 10), got {value!r}")
+
+
+def merged(name: str, params: dict) -> dict:
+    """Defaults of filter ``name`` overridden by ``params``; unknown keys or wrong types raise naming the key."""
+    base = DEFAULTS[name]
+    for key, value in params.items():
+        if key not in base:
+            raise EstimatorInputError(f"estimator.{key}: unknown key for --filter {name} "
+                                      f"(known: {', '.join(sorted(base))})")
+        _check_value(key, base[key], value)
+    return {**base, **params}
+
+
+def _system_of(sat_ids):
+    return np.array([s[0] for s in sat_ids])
+
+
+def _antenna(ds, p) -> int:
+    a = int(p["antenna"])
+    n_ant = ds["gnss/antennas/lever_arm_b"].shape[0]
+    if not 0 <= a < n_ant:
+        raise EstimatorInputError(f"estimator.antenna: expected 0 .. {n_ant - 1}, got {a}")
+    return a
+
+
+def spp_fixes(ds, p):
+    """Single-point fixes of antenna ``p['antenna']`` from /gnss/obs (first tracked signal per satellite)."""
+    sat_ids = ds["gnss/sat_id"][:]
+    signals, lam = list(ds["gnss/signals"][:]), ds["gnss/wavelength_m"][:]
+    gd_all = ds["gnss/group_delay"][:]
+    a = _antenna(ds, p)
+    code = doppler = None
+    for j, sig in enumerate(signals):
+        c = ds[f"gnss/obs/{sig}/code"][:, a, :]
+        d = ds[f"gnss/obs/{sig}/doppler"][:, a, :]
+        if code is None:
+            code, doppler = c.copy(), d.copy()
+            wl, gd = np.full(c.shape[1], lam[j]), gd_all[:, j].copy()
+        take = np.isnan(code).all(0) & ~np.isnan(c).all(0)
+        code[:, take], doppler[:, take], wl[take], gd[take] = c[:, take], d[:, take], lam[j], gd_all[take, j]
+    return spp(ds["gnss/t"][:], code, doppler, wl, ds["gnss/sat_pos_ecef"][:], ds["gnss/sat_clock"][:],
+               _system_of(sat_ids), gd, p["elevation_mask_deg"], p["sigma_code_m"], p["sigma_doppler_m_per_s"])
+
+
+def solve_spp(ds, params, progress=False) -> Solution:
+    p = merged("spp", params)
+    fx = spp_fixes(ds, p)
+    cov = np.full((fx.t.size, 6, 6), np.nan)
+    cov[:, :3, :3], cov[:, 3:, 3:] = fx.pos_cov_enu, fx.vel_cov_enu
+    return Solution(t=fx.t, pos_ecef=fx.pos_ecef, vel_enu=fx.vel_enu, cov=cov,
+                    state_names=("pos_e", "pos_n", "pos_u", "vel_e", "vel_n", "vel_u"),
+                    extras={"clock": fx.clock, "n_sats": fx.n_sats},
+                    extra_units={"clock": "m (one column per system: " + ",".join(fx.systems) + ")",
+                                 "n_sats": "1"},
+                    config={"estimator": "spp", "point": f"antenna {p['antenna']} phase centre", **p})
+
+
+def _truth_fixes(ds, p):
+    """Truth antenna position/velocity plus white noise of the given sigmas (a study input, not a receiver)."""
+    a = int(p["antenna"])
+    t = ds["gnss/t"][:]
+    pos = ds["gnss/truth/antenna_pos_ecef"][:, a]
+    lla = ecef_to_lla(pos)
+    vel = ecef_to_enu_vec(ds["gnss/truth/antenna_vel_ecef"][:, a], lla[:, 0], lla[:, 1])
+    rng = np.random.default_rng(int(p["seed"]))
+    sp = np.broadcast_to(np.asarray(p["truth_pos_sigma_m"], float), 3)
+    sv = float(p["truth_vel_sigma_m_per_s"])
+    pos = pos + enu_to_ecef_vec(rng.normal(size=pos.shape) * sp, lla[:, 0], lla[:, 1])
+    vel = vel + rng.normal(size=vel.shape) * sv
+    cov_p = np.broadcast_to(np.diag(sp**2), (t.size, 3, 3))
+    return t, pos, vel, cov_p, np.broadcast_to(np.eye(3) * sv**2, (t.size, 3, 3))
+
+
+def gnss_fixes(ds, p) -> GnssFixes:
+    lever = ds["gnss/antennas/lever_arm_b"][_antenna(ds, p)]
+    if p["gnss"] == "truth":
+        t, pos, vel, cp, cv = _truth_fixes(ds, p)
+    elif p["gnss"] == "spp":
+        fx = spp_fixes(ds, p)
+        t, pos, vel, cp, cv = fx.t, fx.pos_ecef, fx.vel_enu, fx.pos_cov_enu, fx.vel_cov_enu
+    else:
+        raise EstimatorInputError(f"estimator.gnss: expected 'spp' or 'truth', got {p['gnss']!r}")
+    return GnssFixes(t, pos, vel, cp * float(p["pos_sigma_scale"]) ** 2, cv, lever + np.asarray(
+        p.get("lever_arm_error_m", [0.0, 0.0, 0.0]), float))
+
+
+def imu_data(ds) -> ImuData:
+    if "imu/gyro" in ds:
+        return ImuData(ds["imu/t"][:], ds["imu/gyro"][:], ds["imu/accel"][:])
+    if "imu/dtheta" in ds:
+        return ImuData(ds["imu/t"][:], ds["imu/dtheta"][:], ds["imu/dvel"][:], increments=True)
+    raise EstimatorInputError(f"{ds.path}: no /imu/gyro or /imu/dtheta: the file has no IMU data")
+
+
+def imu_model(ds) -> dict:
+    """The simulated IMU's white noise, turn-on bias and rate random walk per sensor (SI), from /imu attrs."""
+    attrs = ds.group_attrs("imu")
+    out = {}
+    for sensor in ("gyro", "accel"):
+        m = json.loads(attrs[sensor]) if sensor in attrs else {}
+        out[sensor] = (m.get("random_walk", 0.0), m.get("bias_turn_on", 0.0), m.get("rate_random_walk", 0.0),
+                       m.get("bias_instability", 0.0))
+    return out
+
+
+def filter_config(ds, p, name) -> FilterConfig:
+    m = imu_model(ds)
+    pick = lambda key, default: float(p[key]) if p[key] is not None else float(default)  # noqa: E731
+    return FilterConfig(
+        gyro_arw=pick("gyro_arw", max(m["gyro"][0], 1e-7)), accel_vrw=pick("accel_vrw", max(m["accel"][0], 1e-6)),
+        gyro_bias_rw=pick("gyro_bias_rw", m["gyro"][2]), accel_bias_rw=pick("accel_bias_rw", m["accel"][2]),
+        p0_gyro_bias=pick("p0_gyro_bias", max(m["gyro"][1] + m["gyro"][3], 1e-7)),
+        p0_accel_bias=pick("p0_accel_bias", max(m["accel"][1] + m["accel"][3], 1e-5)),
+        p0_att=tuple(np.radians(np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3))),
+        p0_vel=float(p["p0_vel_m_per_s"]), p0_pos=tuple(np.broadcast_to(np.asarray(p["p0_pos_m"], float), 3)),
+        p0_lever=float(p.get("p0_lever_m", 0.5)), cov_dt=float(p["cov_dt_s"]), alpha=float(p.get("alpha", 10.0)),
+        gamma_rule=str(p.get("gamma_rule", "wu")))
+
+
+def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
+    """Initial navigation state from ``p['align']``: 'static' (levelling + gyrocompassing over the first
+    align_static_s; at the first IMU sample), 'motion' (from the first GNSS fix faster than 5 m/s, at its epoch),
+    'truth' (the file's truth at the first sample, a study mode), plus ``init_heading_error_deg``."""
+    good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
+    if good.size == 0:
+        raise EstimatorInputError(f"{ds.path}: no GNSS fix to initialise the position from")
+    g0 = good[0]
+    lla_ant = ecef_to_lla(gnss.pos_ecef[g0])
+    if p["align"] == "truth":
+        euler, lla, vel = ds["truth/euler"][0], ds["truth/pos_lla"][0], ds["truth/vel_enu"][0]
+    elif p["align"] in ("static", "motion"):
+        if p["align"] == "static":
+            n = max(2, int(np.searchsorted(imu.t, imu.t[0] + float(p["align_static_s"]))))
+            rates = imu.gyro[:n] if not imu.increments else imu.gyro[1:n] / np.diff(imu.t[:n])[:, None]
+            force = imu.accel[:n] if not imu.increments else imu.accel[1:n] / np.diff(imu.t[:n])[:, None]
+            euler, _ = static_alignment(rates, force, lla_ant[0])
+            vel = np.zeros(3)
+        else:
+            moving = good[np.hypot(gnss.vel_enu[good, 0], gnss.vel_enu[good, 1]) > 5.0]
+            if moving.size == 0:
+                raise EstimatorInputError("estimator.align: 'motion' needs a GNSS speed above 5 m/s; try 'static'")
+            g0 = moving[0]
+            euler, vel = motion_alignment(gnss.vel_enu[g0]), gnss.vel_enu[g0]
+            lla_ant = ecef_to_lla(gnss.pos_ecef[g0])
+        lla = lla_ant  # the lever arm (metres) is left to the filter's position uncertainty
+    else:
+        raise EstimatorInputError(f"estimator.align: expected 'static', 'motion' or 'truth', got {p['align']!r}")
+    euler = np.asarray(euler, float) + [0.0, 0.0, np.radians(float(p["init_heading_error_deg"]))]
+    t0 = float(gnss.t[g0]) if p["align"] == "motion" else float(imu.t[0])
+    return InitialState(t0, np.asarray(lla, float), np.asarray(vel, float), quat_from_euler(*euler))
+
+
+def _attitude(ds, p) -> AttitudeFixes:
+    """GNSS attitude for the 21-state filter: for now the truth at the GNSS epochs plus white noise of
+    attitude_sigma_deg (until the multi-antenna attitude solution of Estimators II is plugged in)."""
+    t = ds["gnss/t"][:]
+    k = np.clip(np.searchsorted(ds["truth/t"][:], t), 0, ds["truth/t"].shape[0] - 1)
+    sig = np.radians(float(p["attitude_sigma_deg"]))
+    rng = np.random.default_rng(int(p["seed"]) + 1)
+    return AttitudeFixes(t, ds["truth/euler"][:][k] + rng.normal(size=(t.size, 3)) * sig, np.full(3, sig))
+
+
+def solve_filter(name):
+    cls = {"kf15": KalmanFilter15, "kf21": KalmanFilter21, "hinf": HInfinityFilter}[name]
+
+    def solve(ds, params, progress=False) -> Solution:
+        p = merged(name, params)
+        imu, gnss = imu_data(ds), gnss_fixes(ds, p)
+        init = initial_state(ds, p, imu, gnss)
+        att = _attitude(ds, p) if name == "kf21" and p["use_attitude"] else None
+        sol = cls(filter_config(ds, p, name), init).run(imu, gnss, att)
+        return Solution(**{**sol.__dict__, "config": {**sol.config, "params": p}})
+
+    solve.__doc__ = f"simkit solve --filter {name}: {cls.__doc__.splitlines()[0]}"
+    return solve
+
+
+SOLVERS = {"spp": solve_spp, "kf15": solve_filter("kf15"), "kf21": solve_filter("kf21"),
+           "hinf": solve_filter("hinf")}

@@ -1,0 +1,134 @@
+"""Code-based single-point positioning with Doppler velocity (weighted least squares, all epochs at once).
+
+Model per satellite s at epoch k (one signal per satellite, the first tracked in the order given):
+    P + c dT^s - GD^s - T(el) = |r^s - r| + w_e (x^s y - y^s x) / c + c dt_sys(s) + e
+    -lambda D + c dT^s' - e_s . v^s - w_e (v^s_x y - v^s_y x) / c = -e_s . v + c dt'
+with r^s, dT^s the file's satellite position at emission and clock (RTKLIB's satposs convention, the Sagnac term
+added here), GD the code group delay of ``/gnss/group_delay``, T the Saastamoinen slant delay of
+:mod:`simkit.gnss.atmosphere`, one receiver clock per system (G, C, ...), one clock drift; the ionosphere is not
+modelled (single frequency, no broadcast coefficients in the file), which biases the fix by metres. Satellite
+velocity and clock drift are central differences of the stored epochs (second order at the ends); the receiver's
+own Sagnac-rate term (w_e (x^s v_y - y^s v_x) / c, under 1 mm/s) is left out. Weights sin^2(el) / sigma^2; the
+covariance is sigma^2 (A^T W A)^-1 with the a-priori ``sigma_code_m`` and ``sigma_doppler_m_per_s``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..earth import C_LIGHT, OMEGA_E
+from ..frames import ecef_to_enu_matrix, ecef_to_lla
+from ..gnss.atmosphere import troposphere
+from .errors import EstimatorInputError
+
+
+@dataclass(frozen=True)
+class SppFixes:
+    """``t`` (M,) s; ``pos_ecef`` (M, 3) m and ``vel_enu`` (M, 3) m/s of the antenna (NaN where no fix);
+    ``pos_cov_enu`` (M, 3, 3) m^2, ``vel_cov_enu`` (M, 3, 3) (m/s)^2; ``clock`` (M, n_sys) m per system in
+    ``systems``; ``n_sats`` (M,) satellites used."""
+
+    t: np.ndarray
+    pos_ecef: np.ndarray
+    vel_enu: np.ndarray
+    pos_cov_enu: np.ndarray
+    vel_cov_enu: np.ndarray
+    clock: np.ndarray
+    systems: tuple
+    n_sats: np.ndarray
+
+
+def _geometry(r, sat):
+    """Ranges with the Sagnac term (M, S) and unit line-of-sight vectors receiver->satellite (M, S, 3)."""
+    d = sat - r[:, None, :]
+    rho = np.linalg.norm(d, axis=-1)
+    sag = OMEGA_E * (sat[..., 0] * r[:, None, 1] - sat[..., 1] * r[:, None, 0]) / C_LIGHT
+    return rho + sag, d / rho[..., None]
+
+
+def _elevation(r, e):
+    lla = ecef_to_lla(r)
+    m = ecef_to_enu_matrix(lla[:, 0], lla[:, 1])
+    up = np.einsum("mj,msj->ms", m[:, 2, :], e)
+    return np.arcsin(np.clip(up, -1, 1)), lla
+
+
+def _solve(a, y, w, mask):
+    """Batched weighted least squares; rows with ``mask`` False carry no weight. Returns (x, N^-1)."""
+    w = np.where(mask, w, 0.0)
+    n = np.einsum("msi,ms,msj->mij", a, w, a)
+    empty = np.einsum("mii->mi", n) == 0.0
+    n = n + np.einsum("mi,ij->mij", empty * 1.0, np.eye(a.shape[-1]))
+    b = np.einsum("msi,ms,ms->mi", a, w, y)
+    ok = np.linalg.matrix_rank(n) == a.shape[-1]
+    n[~ok] = np.eye(a.shape[-1])
+    ninv = np.linalg.inv(n)
+    return np.einsum("mij,mj->mi", ninv, b), ninv, ok
+
+
+def _position(code, sat, sys_onehot, mask_rad, sigma, iterations):
+    m, s = code.shape
+    x = np.zeros((m, 3 + sys_onehot.shape[1]))
+    used = np.isfinite(code)
+    for it in range(iterations):
+        rho, e = _geometry(x[:, :3], sat)
+        el, lla = _elevation(x[:, :3], e)
+        late = it >= 3
+        trop = troposphere(lla[:, None, 0], np.clip(lla[:, None, 2], -500, 1e5), np.clip(el, 0.05, None)) if late \
+            else 0.0
+        used = np.isfinite(code) & ((el >= mask_rad) if late else True)
+        y = np.nan_to_num(code - trop - rho - x[:, 3:] @ sys_onehot.T)
+        a = np.concatenate([-e, np.broadcast_to(sys_onehot, (m, s, sys_onehot.shape[1]))], axis=-1)
+        w = (np.clip(np.sin(el), 0.1, 1.0) ** 2 if late else np.ones((m, s))) / sigma**2
+        dx, ninv, ok = _solve(a, y, w, used)
+        x = x + dx
+    return x, e, el, used, ninv, ok
+
+
+def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, group_delay_m=None,
+        elevation_mask_deg=10.0, sigma_code_m=3.0, sigma_doppler_m_per_s=0.1, iterations=10) -> SppFixes:
+    """Single-point position and velocity. ``code`` (M, S) m and ``doppler`` (M, S) Hz of one antenna (NaN
+    where not tracked); ``wavelength_m`` (S,) per satellite's signal; ``sat_pos_ecef`` (M, S, 3) m;
+    ``sat_clock_s`` (M, S) s; ``systems`` (S,) system letters; ``group_delay_m`` (S,) m."""
+    t, code, doppler = np.asarray(t, float), np.asarray(code, float), np.asarray(doppler, float)
+    m, s = code.shape
+    if sat_pos_ecef.shape != (m, s, 3) or doppler.shape != (m, s) or sat_clock_s.shape != (m, s):
+        raise EstimatorInputError(f"spp: expected code/doppler (M, S), sat_pos_ecef (M, S, 3), sat_clock (M, S) "
+                                  f"with M={m}, S={s}; got {doppler.shape}, {sat_pos_ecef.shape}, {sat_clock_s.shape}")
+    names = tuple(sorted(set(systems)))
+    onehot = (np.asarray(systems)[:, None] == np.array(names)[None, :]).astype(float)
+    gd = np.zeros(s) if group_delay_m is None else np.nan_to_num(np.asarray(group_delay_m, float))
+    sat = np.nan_to_num(sat_pos_ecef)
+    corrected = code + C_LIGHT * sat_clock_s - gd
+    x, e, el, used, ninv, ok = _position(corrected, sat, onehot, np.radians(elevation_mask_deg), sigma_code_m,
+                                         iterations)
+    n_used = used.sum(1)
+    good = ok & (n_used >= 3 + (onehot[None] * used[..., None]).any(1).sum(1))
+    x[~good] = np.nan
+    vel, vcov = _velocity(t, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, x[:, :3], e, el,
+                          used & good[:, None], sigma_doppler_m_per_s)
+    lla = ecef_to_lla(x[:, :3])
+    rot = ecef_to_enu_matrix(lla[:, 0], lla[:, 1])
+    w_pos = np.einsum("mij,mjk,mlk->mil", rot, ninv[:, :3, :3], rot)
+    vel_enu = np.einsum("mij,mj->mi", rot, vel)
+    v_cov = np.einsum("mij,mjk,mlk->mil", rot, vcov, rot)
+    return SppFixes(t, x[:, :3], vel_enu, w_pos, v_cov, x[:, 3:], names, np.where(good, n_used, 0))
+
+
+def _velocity(t, doppler, wavelength, sat, clk, r, e, el, used, sigma):
+    m, s = doppler.shape
+    if m < 2:
+        return np.full((m, 3), np.nan), np.full((m, 3, 3), np.nan)
+    vs = np.gradient(sat, t, axis=0, edge_order=2 if m > 2 else 1)
+    clk_rate = np.gradient(clk, t, axis=0, edge_order=2 if m > 2 else 1)
+    sagnac_rate = OMEGA_E * (vs[..., 0] * r[:, None, 1] - vs[..., 1] * r[:, None, 0]) / C_LIGHT
+    y = -np.asarray(wavelength, float)[None, :] * doppler + C_LIGHT * clk_rate - np.einsum("msj,msj->ms", e, vs) \
+        - sagnac_rate
+    used = used & np.isfinite(y)
+    a = np.concatenate([-e, np.ones((m, s, 1))], axis=-1)
+    w = np.clip(np.sin(el), 0.1, 1.0) ** 2 / sigma**2
+    x, ninv, ok = _solve(a, np.nan_to_num(y), w, used)
+    bad = ~ok | (used.sum(1) < 4)
+    x[bad] = np.nan
+    return x[:, :3], ninv[:, :3, :3]
