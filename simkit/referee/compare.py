@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .. import frames
+from .. import earth, frames
 from ..solution import Solution
 from . import quat
 from .errors import RefereeInputError
@@ -26,6 +26,12 @@ STATE_SERIES = {
     **{f"att_{a}": ("att_enu", i, 1.0) for i, a in enumerate("enu")},
     "pos_d": ("pos_enu", 2, -1.0), "vel_d": ("vel_enu", 2, -1.0), "att_d": ("att_enu", 2, -1.0),
     "pitch": ("euler", 0, 1.0), "roll": ("euler", 1, 1.0), "heading": ("euler", 2, 1.0),
+    # simkit.estimators' error states (computed minus true): C~ = (I - [phi x]) C, so phi = -att; dv = vel
+    **{f"phi_{a}": ("att_enu", i, -1.0) for i, a in enumerate("enu")},
+    **{f"dv_{a}": ("vel_enu", i, 1.0) for i, a in enumerate("enu")},
+    "d_h": ("pos_enu", 2, 1.0),
+    # latitude / longitude errors in radians: north / east metres over the radii of curvature (see Errors.state)
+    "d_lat": ("pos_enu", 1, 1.0), "d_lon": ("pos_enu", 0, 1.0),
 }
 
 
@@ -41,6 +47,7 @@ class Errors:
     vel_enu: np.ndarray | None
     euler: np.ndarray | None
     att_enu: np.ndarray | None
+    lla: np.ndarray | None = None   # (K, 3) true lat, lon (rad), height (m): scales of d_lat / d_lon
 
     def state(self, name: str) -> np.ndarray | None:
         """The (K,) error series of a covariance state name (see :data:`STATE_SERIES`), or None."""
@@ -48,7 +55,13 @@ class Errors:
             return None
         series, k, sign = STATE_SERIES[name]
         x = getattr(self, series)
-        return None if x is None else sign * x[:, k]
+        if x is None:
+            return None
+        if name in ("d_lat", "d_lon"):
+            rm, rn = earth.radii(self.lla[:, 0])
+            h = self.lla[:, 2]
+            return x[:, k] / ((rm + h) if name == "d_lat" else (rn + h) * np.cos(self.lla[:, 0]))
+        return sign * x[:, k]
 
 
 def wrap(angle):
@@ -85,4 +98,4 @@ def compare(truth: Truth, sol: Solution, where: str = "estimate") -> Errors:
         rot, rot_true = rot[index], Rotation.from_quat(ref.quat_nb)
         eul = wrap(frames.euler_from_attitude(rot) - frames.euler_from_attitude(rot_true))
         att = quat.as_rotvec(quat.mul(rot.as_quat(), quat.conj(ref.quat_nb)))
-    return Errors(t, index, pos, vel, eul, att)
+    return Errors(t, index, pos, vel, eul, att, frames.ecef_to_lla(ref.pos_ecef))
