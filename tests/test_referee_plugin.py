@@ -135,3 +135,27 @@ def test_pyins_strapdown_of_an_ideal_imu_reproduces_the_truth(tmp_path):
     # truth generation at the cm / mm/s level; any convention slip (a swapped axis, a sign) gives metres and degrees
     assert st["horizontal"]["max"] < 0.05 and st["up"]["max"] < 0.5 and st["velocity_3d"]["max"] < 0.02
     assert max(st[q]["max"] for q in ("pitch", "roll", "heading")) < 1e-3        # degrees
+
+
+@pytest.mark.slow   # both filters over 40 s of airborne_stim300; pyins' batch filter dominates
+def test_simkit_kf15_and_pyins_side_by_side_through_the_plugin(air):
+    """The same interface, the same file, the same referee: simkit's KF15 and pyins' loosely coupled filter.
+    Both fix code-only positions with the ionosphere left in, so metre-level position errors are expected;
+    simkit's filter carries its error-state covariance, whose NEES the referee evaluates."""
+    sys.path.insert(0, str(ROOT / "examples"))
+    from pyins_loosely_coupled import PyinsLooselyCoupled
+    from simkit_kf15 import SimkitKf15
+
+    ours = referee.run(SimkitKf15(), air)
+    theirs = referee.run(PyinsLooselyCoupled(), air)
+    rows = []
+    for name, res in (("simkit KF15", ours), ("pyins", theirs)):
+        st = res.score.statistics
+        rows.append(f"{name:12s} RMS horizontal {st['horizontal']['rms']:.2f}, up {st['up']['rms']:.2f}, "
+                    f"velocity {st['velocity_3d']['rms']:.3f}, heading {st['heading']['rms']:.3f} "
+                    f"(units of simkit.referee.stats.UNIT_OF); {res.timing['total_s']:.1f} s")
+    print("\n" + "\n".join(rows))
+    assert ours.score.nees is not None and ours.score.nees["dof_mean"] == 9.0
+    for res in (ours, theirs):
+        st = res.score.statistics
+        assert st["horizontal"]["rms"] < 20.0 and st["velocity_3d"]["rms"] < 2.0
