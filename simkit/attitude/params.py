@@ -13,7 +13,8 @@ AMBIGUITY_DEFAULTS = {
     "ratio_threshold": 3.0,       # accept a fix when 2nd / best cost >= this (0: accept every finished search)
     "partial_p0": 0.0,            # LAMBDA: partial fixing of rejected epochs at this bootstrapped rate; 0: off
     "max_nodes": 1_000_000,       # search work cap per epoch (nodes)
-    "attitude": "svd",            # "svd" (Wahba), "badshah" (eq 10), "baseline" (heading and pitch of baseline 1)
+    "attitude": "wls",            # "wls" (full-covariance fit; MC-LAMBDA: its own rotation), "svd" (Wahba, weight
+                                  # 1/trace per baseline), "badshah" (eq 10), "baseline" (baseline 1 heading, pitch)
     "pll_bandwidth_hz": 15.0,     # carrier thermal noise from C/N0 (Kaplan & Hegarty PLL jitter)
     "dll_bandwidth_hz": 1.0,      # code thermal noise from C/N0 (DLL jitter)
     "correlator_spacing_chips": 0.5,
@@ -23,6 +24,7 @@ AMBIGUITY_DEFAULTS = {
     "multipath_elevation_deg": 20.0,  # e-folding elevation of the multipath profile (deg)
     "start_s": 0.0,               # first epoch solved (s since start)
     "stop_s": float("inf"),       # last epoch solved (s since start)
+    "every": 1,                   # solve every n-th epoch only (1: all)
 }
 
 TDCP_DEFAULTS = {
@@ -33,6 +35,7 @@ TDCP_DEFAULTS = {
     "slip_threshold": 5.0,        # reject a time difference whose residual exceeds this many sigma
     "start_s": 0.0,
     "stop_s": float("inf"),
+    "every": 1,                   # difference every n-th epoch with the one before it
 }
 
 

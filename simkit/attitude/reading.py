@@ -60,7 +60,9 @@ def read(ds, p: dict) -> FileData:
     sel = np.flatnonzero((t_all >= p["start_s"]) & (t_all <= p["stop_s"]))
     if sel.size == 0:
         raise AttitudeInputError("estimator.start_s", f"no GNSS epoch in [{p['start_s']}, {p['stop_s']}] s")
-    sl = slice(sel[0], sel[-1] + 1)
+    if p["every"] < 1:
+        raise AttitudeInputError("estimator.every", f"{p['every']}; expected an integer >= 1")
+    sl = slice(sel[0], sel[-1] + 1, p["every"])
     names = _signals(ds, p["signals"])
     sat_pos, sat_clock = ds["gnss/sat_pos_ecef"][sl], ds["gnss/sat_clock"][sl]
     code = np.stack([ds[f"gnss/obs/{g}/code"][sl] for g in names])

@@ -15,6 +15,7 @@ from .resolve import Resolution, resolve
 
 STATUS = {"none": -1, "float": 0, "fixed": 1, "partial": 2, "wrong fix": 3}
 _METHOD = {"attitude": "lambda", "attitude_c": "clambda", "attitude_mc": "mclambda"}
+SOLVER_NAMES = tuple(_METHOD)
 
 
 def _progress(items, progress, desc):
@@ -48,15 +49,19 @@ def _attitude(res: Resolution, F: np.ndarray, method: str, kind: str):
         pitch, heading, cov = wahba.single_baseline(b[:, :, 0], res.Qb[:, :3, :3], F[:, 0])
         R = Rotation.from_euler("ZX", np.stack([-heading, pitch], -1)).as_matrix()
         return R, cov, ("pitch", "heading")
-    if method == "mclambda":
-        R = np.where(res.accepted[:, None, None], res.rotation, wahba.wahba_svd(b, F))
-    elif kind == "badshah":
-        R = wahba.badshah_eq10(b, F)
+    if method == "mclambda" and kind == "wls":
+        R = np.where(res.accepted[:, None, None], res.rotation, wahba.wahba_wls(b, F, res.Qb))
+        P = wahba.phi_covariance(R, F, res.Qb)
+    elif kind == "wls":
+        R = wahba.wahba_wls(b, F, res.Qb)
+        P = wahba.phi_covariance(R, F, res.Qb)
     else:
         w = 1.0 / np.stack([np.trace(res.Qb[:, 3 * j:3 * j + 3, 3 * j:3 * j + 3], axis1=1, axis2=2)
                             for j in range(r)], -1)
-        R = wahba.wahba_svd(b, F, w)
-    cov = wahba.euler_covariance(R, wahba.phi_covariance(R, F, res.Qb))
+        est = (lambda x: wahba.wahba_svd(x, F, w)) if kind == "svd" else (lambda x: wahba.badshah_eq10(x, F))
+        R = est(b)
+        P = wahba.propagated_covariance(est, b, res.Qb)
+    cov = wahba.euler_covariance(R, P)
     return R, cov, ("pitch", "roll", "heading")
 
 
@@ -120,14 +125,16 @@ _UNITS = {"status": "-1 none, 0 float, 1 fixed, 2 partial, 3 wrong fix", "ratio"
           "baseline_float_enu": "m", "atdop": "rad/m", "sigma_dd_carrier": "m"}
 
 
-def _solver(name: str):
+def solver(name: str):
+    """The registry function of ``name`` (one of :data:`SOLVER_NAMES`)."""
     method = _METHOD[name]
 
     def solve(ds, params: dict | None = None, progress: bool = False) -> Solution:
         """Attitude from the file's multi-antenna carrier phase (see docs/attitude.md)."""
         p = merge(AMBIGUITY_DEFAULTS, params, name)
-        if p["attitude"] not in ("svd", "badshah", "baseline"):
-            raise AttitudeInputError("estimator.attitude", f"{p['attitude']!r}; expected svd, badshah or baseline")
+        if p["attitude"] not in ("wls", "svd", "badshah", "baseline"):
+            raise AttitudeInputError("estimator.attitude",
+                                     f"{p['attitude']!r}; expected wls, svd, badshah or baseline")
         fd = read(ds, p)
         if method == "mclambda" and fd.lever_arm.shape[0] < 3:
             raise AttitudeInputError("gnss/antennas/lever_arm_b", "MC-LAMBDA needs at least 3 antennas")
@@ -145,6 +152,6 @@ def _solver(name: str):
 
 def build_registry() -> dict:
     from .tdcp import solve_tdcp
-    reg = {name: _solver(name) for name in _METHOD}
+    reg = {name: solver(name) for name in _METHOD}
     reg["tdcp"] = solve_tdcp
     return reg

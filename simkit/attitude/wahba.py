@@ -103,3 +103,36 @@ def atdop(R: np.ndarray, F: np.ndarray, G: np.ndarray) -> np.ndarray:
     J = euler_jacobian(R)
     P = J @ np.linalg.inv(np.swapaxes(H, 1, 2) @ H) @ np.swapaxes(J, 1, 2)
     return np.sqrt(np.diagonal(P, axis1=1, axis2=2))
+
+
+def wahba_wls(b: np.ndarray, F: np.ndarray, Qb: np.ndarray, iterations: int = 3) -> np.ndarray:
+    """Full-weight attitude: min_R (b - vec(R F))' Qb^-1 (b - vec(R F)), from the SVD solution by Gauss-Newton
+    on SO(3). ``b`` (K, 3, r) m ENU, ``Qb`` (K, 3 r, 3 r) m^2 (baseline-major). Its covariance is
+    :func:`phi_covariance` (the estimator is efficient to first order)."""
+    K, r = b.shape[0], F.shape[1]
+    R = wahba_svd(b, F)
+    y = b.transpose(0, 2, 1).reshape(K, 3 * r)
+    for _ in range(iterations):
+        RF = np.einsum("kij,jr->kri", R, F)
+        H = -skew(RF).reshape(K, 3 * r, 3)
+        WH = np.linalg.solve(Qb, H)
+        g = np.einsum("kri,kr->ki", WH, y - RF.reshape(K, -1))
+        phi = np.linalg.solve(np.swapaxes(H, 1, 2) @ WH, g[..., None])[..., 0]
+        R = Rotation.from_rotvec(phi).as_matrix() @ R
+    return R
+
+
+def propagated_covariance(estimator, b: np.ndarray, Qb: np.ndarray, eps: float = 1e-6) -> np.ndarray:
+    """Covariance (K, 3, 3) rad^2 of the ENU attitude error of ``estimator(b) -> R`` (b (K, 3, r) -> (K, 3, 3)),
+    J Qb J' with J = d phi / d vec(b) by central differences (so each estimator's own linearisation is used)."""
+    K, _, r = b.shape
+    R0 = estimator(b)
+    J = np.empty((K, 3, 3 * r))
+    for j in range(r):
+        for i in range(3):
+            step = np.zeros_like(b)
+            step[:, i, j] = eps
+            hi, lo = estimator(b + step), estimator(b - step)
+            J[:, :, 3 * j + i] = (Rotation.from_matrix(hi @ np.swapaxes(R0, 1, 2)).as_rotvec()
+                                  - Rotation.from_matrix(lo @ np.swapaxes(R0, 1, 2)).as_rotvec()) / (2 * eps)
+    return J @ Qb @ np.swapaxes(J, 1, 2)
