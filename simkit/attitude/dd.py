@@ -140,18 +140,21 @@ def float_solution(obs: Observations, mask_rad: float = 0.0, max_sats: int | Non
 
 def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:
     """Batch least squares of one channel pattern (see the module docstring)."""
-    n_sig, _, n_ant, n_sat = obs.carrier.shape
+    n_ant = obs.carrier.shape[2]
     r, n = n_ant - 1, len(sat)
-    D = dd_operator(signal, sat, ref, n_ant, n_sat, n_sig)
+    sigs, sig_i = np.unique(signal, return_inverse=True)
+    cols, col_i = np.unique(np.concatenate([sat, ref]), return_inverse=True)  # only the satellites used
+    D = dd_operator(sig_i, col_i[:n], col_i[n:], n_ant, len(cols), len(sigs))
     lam = np.tile(obs.wavelength[signal], r)  # (r n,)
 
-    def take(x):
-        return np.nan_to_num(x[:, epochs].transpose(1, 0, 2, 3).reshape(len(epochs), -1))
+    def take(x):  # (G, M, A, S) -> (K, G' A S') in the column order of D
+        sub = x[sigs[:, None], epochs[None, :]][..., cols]
+        return np.nan_to_num(sub.transpose(1, 0, 2, 3).reshape(len(epochs), -1))
 
-    y_phi = take(obs.carrier * obs.wavelength[:, None, None, None]) @ D.T
+    y_phi = (take(obs.carrier) * np.repeat(obs.wavelength[sigs], n_ant * len(cols))) @ D.T
     y_p = take(obs.code) @ D.T
-    Qphi = (D * take(obs.var_carrier)[:, None, :]) @ D.T
-    Qp = (D * take(obs.var_code)[:, None, :]) @ D.T
+    Qphi = np.einsum("ij,kj,lj->kil", D, take(obs.var_carrier), D, optimize=True)
+    Qp = np.einsum("ij,kj,lj->kil", D, take(obs.var_code), D, optimize=True)
     e = obs.los[epochs]
     G1 = -(e[:, sat, :] - e[:, ref, :])  # (K, n, 3)
     G = np.zeros((len(epochs), r * n, 3 * r))

@@ -93,7 +93,7 @@ def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float 
     stop = ratio_threshold if ratio_threshold > 0 else 3.0
     z, ratio, finished, rot, bounded = _search(grp, method, np.asarray(F, float), max_nodes, stop)
     sr = _success_rates(grp.Qa)
-    accepted = finished & (ratio >= ratio_threshold)
+    accepted = finished & ((ratio >= ratio_threshold) | (ratio_threshold <= 0))
     b, Qb = conditioned(grp, z.astype(float))
     b = np.where(accepted[:, None], b, grp.b_hat)
     Qb = np.where(accepted[:, None, None], Qb, grp.Qb)
