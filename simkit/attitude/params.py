@@ -25,6 +25,8 @@ AMBIGUITY_DEFAULTS = {
     "start_s": 0.0,               # first epoch solved (s since start)
     "stop_s": float("inf"),       # last epoch solved (s since start)
     "every": 1,                   # solve every n-th epoch only (1: all)
+    "continuity": 1,              # 1: keep an accepted fix until a loss-of-lock flag or gap (not with every > 1);
+                                  # 0: every epoch on its own (single-epoch resolution)
 }
 
 TDCP_DEFAULTS = {

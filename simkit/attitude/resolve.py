@@ -127,3 +127,61 @@ def _partial(grp, p0, accepted, partial, b, Qb, z_check, Zs):
         Qb[i] = grp.Qb[i] - K @ Z.T @ grp.Qba[i].T
         partial[i] = True
         z_check[i], Zs[i] = pf.z_fixed, pf.Z_fixed
+
+
+def subset(grp: FloatGroup, idx: np.ndarray) -> FloatGroup:
+    """The epochs ``idx`` (indices into the group) of ``grp``."""
+    return FloatGroup(grp.epochs[idx], grp.signal, grp.sat, grp.ref, *(getattr(grp, f)[idx] for f in
+                      ("a_hat", "Qa", "b_hat", "Qb", "Qba", "G", "Qphi")))
+
+
+def _first_fixes(grp, breaks, method, F, kw):
+    """Search run by run (a run: epochs between continuity breaks) until each run has an accepted fix; chunks
+    double (1, 2, 4, ... epochs per run) so a run that never fixes costs O(log) calls. Returns (searched
+    {epoch: (Resolution, row)}, first accepted epoch per run or -1, run id per epoch)."""
+    run = np.cumsum(breaks) - 1
+    starts, ends = np.flatnonzero(breaks), np.append(np.flatnonzero(breaks)[1:], len(breaks))
+    first = np.full(len(starts), -1)
+    pos, step, searched = starts.copy(), 1, {}
+    pending = np.arange(len(starts))
+    while pending.size:
+        idx = np.concatenate([np.arange(pos[q], min(pos[q] + step, ends[q])) for q in pending])
+        res = resolve(subset(grp, idx), method, F, **kw)
+        for row, i in enumerate(idx):
+            searched[i] = (res, row)
+        acc = idx[res.accepted]
+        for q in pending:
+            hit = acc[(acc >= pos[q]) & (acc < ends[q])]
+            first[q] = hit.min() if hit.size else -1
+        pos[pending] += step
+        pending = pending[(first[pending] < 0) & (pos[pending] < ends[pending])]
+        step *= 2
+    return searched, first, run
+
+
+def resolve_held(grp: FloatGroup, method: str, F: np.ndarray, breaks: np.ndarray, **kw) -> Resolution:
+    """:func:`resolve` with ambiguity continuity: after the first accepted fix of a run of epochs without a
+    break (``breaks`` (K,) bool: a gap in the epochs or a loss-of-lock flag on any channel used), the later
+    epochs of the run keep that fix (their ``ratio`` is NaN: not searched). Epochs before it are searched."""
+    searched, first, run = _first_fixes(grp, np.asarray(breaks, bool), method, F, kw)
+    K = len(run)
+    fields = {f: [] for f in ("z", "ratio", "accepted", "partial", "finished", "rotation", "bounded")}
+    z_check, Zs, b, Qb = [None] * K, [None] * K, grp.b_hat.copy(), grp.Qb.copy()
+    held = (first[run] >= 0) & (np.arange(K) > first[run])
+    zh = np.zeros(grp.a_hat.shape)
+    for i in range(K):
+        src, row = searched[first[run[i]]] if held[i] else searched[i]
+        for f in fields:
+            fields[f].append(getattr(src, f)[row])
+        z_check[i], Zs[i] = src.z_check[row], src.Z[row]
+        zh[i] = src.z[row]
+        if not held[i]:
+            b[i], Qb[i] = src.b[row], src.Qb[row]
+    if held.any():
+        bh, Qh = conditioned(subset(grp, held), zh[held])
+        b[held], Qb[held] = bh, Qh
+    out = {f: np.array(v) for f, v in fields.items()}
+    out["ratio"][held] = np.nan
+    out["rotation"][held] = np.nan
+    return Resolution(out["z"], out["ratio"], out["accepted"], out["partial"], _success_rates(grp.Qa),
+                      out["finished"], b, Qb, out["rotation"], z_check, Zs, out["bounded"])

@@ -11,7 +11,7 @@ from .dd import FloatGroup, dd_operator, float_solution
 from .errors import AttitudeInputError
 from .params import AMBIGUITY_DEFAULTS, merge
 from .reading import FileData, read
-from .resolve import Resolution, resolve
+from .resolve import Resolution, resolve, resolve_held
 
 STATUS = {"none": -1, "float": 0, "fixed": 1, "partial": 2, "wrong fix": 3}
 _METHOD = {"attitude": "lambda", "attitude_c": "clambda", "attitude_mc": "mclambda"}
@@ -41,6 +41,16 @@ def _wrong(grp: FloatGroup, res: Resolution, fd: FileData) -> np.ndarray:
     return out, truth
 
 
+def continuity_breaks(grp: FloatGroup, lli: np.ndarray) -> np.ndarray:
+    """(K,) bool: the group's epochs where ambiguity continuity breaks: the first, after a gap in the epochs, or
+    with a loss-of-lock flag (``lli`` (G, M, A, S) > 0) on any antenna for a satellite or reference used."""
+    e = grp.epochs
+    gap = np.ones(len(e), bool)
+    gap[1:] = np.diff(e) != 1
+    flags = lli[grp.signal[:, None], e[None, :]][:, :, :, np.concatenate([grp.sat, grp.ref])] > 0  # (n, K, A, 2n)
+    return gap | flags.any(axis=(0, 2, 3))
+
+
 def _attitude(res: Resolution, F: np.ndarray, method: str, kind: str):
     """(R (K, 3, 3), cov (K, X, X), names) from the fixed baselines."""
     K, r = len(res.b), F.shape[1]
@@ -50,7 +60,7 @@ def _attitude(res: Resolution, F: np.ndarray, method: str, kind: str):
         R = Rotation.from_euler("ZX", np.stack([-heading, pitch], -1)).as_matrix()
         return R, cov, ("pitch", "heading")
     if method == "mclambda" and kind == "wls":
-        R = np.where(res.accepted[:, None, None], res.rotation, wahba.wahba_wls(b, F, res.Qb))
+        R = np.where(np.isfinite(res.rotation), res.rotation, wahba.wahba_wls(b, F, res.Qb))
         P = wahba.phi_covariance(R, F, res.Qb)
     elif kind == "wls":
         R = wahba.wahba_wls(b, F, res.Qb)
@@ -109,7 +119,12 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
     out = _empty(M, a - 1, g, s, names)
     groups = float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None)
     for grp in _progress(groups, progress, f"attitude ({method})"):
-        res = resolve(grp, method, F, p["ratio_threshold"], p["partial_p0"] or None, int(p["max_nodes"]))
+        kw = dict(ratio_threshold=p["ratio_threshold"], partial_p0=p["partial_p0"] or None,
+                  max_nodes=int(p["max_nodes"]))
+        if p["continuity"] and p["every"] == 1:
+            res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), **kw)
+        else:
+            res = resolve(grp, method, F, **kw)
         R, cov, _ = _attitude(res, F, method, p["attitude"])
         _store(out, grp, res, fd, R, cov)
         if not single:
