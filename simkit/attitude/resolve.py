@@ -24,8 +24,8 @@ class Resolution:
     ``z`` (K, r n) float cycles, the best integer candidate (NaN for partial fixes); ``ratio`` (K,); ``accepted``
     (K,) bool; ``partial`` (K,) bool (a subset fixed); ``success_rate`` (K,) bootstrapped (of Qa, decorrelated);
     ``finished`` (K,) bool (the search completed within its work cap; ``bounded`` (K,) bool: the constrained
-    search stopped once the ratio was known to pass, so ``ratio`` is a lower bound); ``b`` (K, 3 r) m ENU baselines given the
-    fix (float where nothing was accepted); ``Qb`` (K, 3 r, 3 r) m^2; ``rotation`` (K, 3, 3) body -> ENU of
+    search stopped once the ratio was known to pass, so ``ratio`` is a lower bound); ``b`` (K, 3 r) m ENU
+    baselines given the fix (float where nothing was accepted); ``Qb`` (K, 3 r, 3 r) m^2; ``rotation`` (K, 3, 3) body -> ENU of
     MC-LAMBDA (NaN otherwise); ``z_check`` (K, p) the fixed combinations and ``Z`` (K, r n, p) the integer maps
     (z_check = Z' a for the true a when right) used to label wrong fixes, p = r n for full fixes.
     """

@@ -77,8 +77,10 @@ def _attitude(res: Resolution, F: np.ndarray, method: str, kind: str):
 
 def _empty(M: int, r: int, g: int, s: int, names) -> dict:
     nan = np.nan
-    return {"quat": np.full((M, 4), nan), "euler": np.full((M, 3), nan), "cov": np.full((M, len(names), len(names)), nan),
-            "status": np.full(M, -1, np.int8), "ratio": np.full(M, nan), "ratio_is_bound": np.zeros(M, bool), "success_rate": np.full(M, nan),
+    x = len(names)
+    return {"quat": np.full((M, 4), nan), "euler": np.full((M, 3), nan), "cov": np.full((M, x, x), nan),
+            "status": np.full(M, -1, np.int8), "ratio": np.full(M, nan), "ratio_is_bound": np.zeros(M, bool),
+            "success_rate": np.full(M, nan),
             "n_sats": np.zeros(M, np.int16), "dd_ambiguity": np.full((M, r, g, s), nan),
             "dd_ambiguity_true": np.full((M, r, g, s), nan), "reference_sat": np.full((M, g, s), -1, np.int16),
             "baseline_enu": np.full((M, r, 3), nan), "baseline_body": np.full((M, r, 3), nan),
@@ -134,7 +136,8 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
     return out, names
 
 
-_UNITS = {"status": "-1 none, 0 float, 1 fixed, 2 partial, 3 wrong fix", "ratio": "1", "ratio_is_bound": "bool", "success_rate": "1",
+_UNITS = {"status": "-1 none, 0 float, 1 fixed, 2 partial, 3 wrong fix", "ratio": "1", "ratio_is_bound": "bool",
+          "success_rate": "1",
           "n_sats": "1", "dd_ambiguity": "cycles", "dd_ambiguity_true": "cycles",
           "reference_sat": "index into /gnss/sat_id", "baseline_enu": "m", "baseline_body": "m",
           "baseline_float_enu": "m", "atdop": "rad/m", "sigma_dd_carrier": "m"}
