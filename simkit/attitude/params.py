@@ -38,6 +38,7 @@ TDCP_DEFAULTS = {
     "start_s": 0.0,
     "stop_s": float("inf"),
     "every": 1,                   # difference every n-th epoch with the one before it
+    "troposphere": 1,             # 1: remove the modelled troposphere change (Saastamoinen, at the code position)
 }
 
 

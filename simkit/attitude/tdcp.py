@@ -5,7 +5,8 @@ applied, unit line of sight e from the receiver):
 
     z_s = lambda dphi_s + c d(dt_s) - (rho_hat_j - rho_hat_{j-1}) = -e_j . (dr - dr_hat) + c d(dt_r),
 
-with rho_hat from the code position of epoch j-1 moved by dr_hat (iterated), so z is linear in [dr, c d(dt_r)]
+after removing the modelled troposphere (Saastamoinen with the mapping of simkit.gnss.atmosphere at the code
+position; it changes by cm/s on a climb), with rho_hat from the code position of epoch j-1 moved by dr_hat (iterated), so z is linear in [dr, c d(dt_r)]
 (four unknowns, at least 5 satellites for the residual test). Slips: LLI set at either epoch drops the
 difference; afterwards the largest normalised residual above ``slip_threshold`` is dropped and the epoch re-solved
 (up to 3 times). Velocity = dr / dt in ENU (m/s), attributed to the middle of the interval.
@@ -15,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..frames import ecef_to_enu_matrix, ecef_to_lla
+from ..gnss.atmosphere import troposphere
 from ..solution import Solution
 from .errors import AttitudeInputError
 from .geometry import C_LIGHT, sagnac_rotate
@@ -30,18 +32,20 @@ def _lsq(H, z, w):
 
 
 def tdcp_velocity(phase_m, usable, sat_pos, sat_clock, receiver, dt, sigma_m=0.003, slip_threshold=5.0,
-                  iterations=3):
+                  iterations=3, delay_m=None):
     """Antenna displacement per interval from carrier (K+1 epochs).
 
     ``phase_m`` (K+1, R) carrier in metres, R = rows (signal, satellite); ``usable`` (K, R) bool (tracked at both
     epochs, no LLI); ``sat_pos`` (K+1, R, 3) m ECEF (transmit frame), ``sat_clock`` (K+1, R) s; ``receiver``
-    (K+1, 3) m ECEF approximate; ``dt`` (K,) s. Returns (velocity (K, 3) m/s ECEF, clock drift (K,) m/s, used
+    (K+1, 3) m ECEF approximate; ``dt`` (K,) s; ``delay_m`` (K+1, R) modelled atmospheric delays removed
+    from the phase (e.g. troposphere; None: none). Returns (velocity (K, 3) m/s ECEF, clock drift (K,) m/s, used
     (K, R) bool after slip rejection, residual rms (K,) m); NaN where fewer than 5 rows remain.
     """
     s = sagnac_rotate(sat_pos, receiver)
     x0 = receiver[:-1]
     dr = np.zeros_like(x0)
     w = usable.astype(float)
+    phase_m = phase_m if delay_m is None else phase_m - delay_m
     z_carrier = np.nan_to_num(phase_m[1:] - phase_m[:-1]) + C_LIGHT * np.nan_to_num(sat_clock[1:] - sat_clock[:-1])
     rho0 = np.linalg.norm(s[:-1] - x0[:, None], axis=-1)
     for _ in range(iterations + 3):
@@ -85,9 +89,11 @@ def solve_tdcp(ds, params: dict | None = None, progress: bool = False) -> Soluti
     sat_pos, sat_clock = np.tile(fd.sat_pos, (1, g, 1)), np.tile(fd.sat_clock, (1, g))
     receiver = fd.receiver
     dt = np.diff(fd.t)
-    vel, drift, used, rms = tdcp_velocity(phase, usable, sat_pos, sat_clock, receiver, dt,
-                                          p["carrier_sigma_m"], p["slip_threshold"])
-    lla = ecef_to_lla(receiver[:-1])
+    lla = ecef_to_lla(receiver)
+    tropo = troposphere(lla[:, 0:1], lla[:, 2:3], np.tile(np.maximum(fd.obs.elevation, 0.05), (1, g)))
+    vel, drift, used, rms = tdcp_velocity(phase, usable, sat_pos, sat_clock, receiver, dt, p["carrier_sigma_m"],
+                                          p["slip_threshold"], delay_m=tropo if p["troposphere"] else None)
+    lla = lla[:-1]
     vel_enu = np.einsum("kij,kj->ki", ecef_to_enu_matrix(lla[:, 0], lla[:, 1]), vel)
     extras = {"vel_enu_antenna": vel_enu, "clock_drift": drift, "n_used": used.sum(1).astype(np.int16),
               "n_rejected": (usable & ~used).sum(1).astype(np.int16), "residual_rms": rms}
