@@ -66,3 +66,21 @@ def test_parameters_are_checked(xian):
         SOLVERS["tdcp"](ds, {"antenna": 5}, False)
     with pytest.raises(AttitudeInputError, match="estimator.max_sats"):
         SOLVERS["attitude"](ds, {"max_sats": "many"}, False)
+
+
+def test_single_epoch_lambda_rates_agree_with_the_predicted_success_rate(tmp_path):
+    """Wang's site, 6 and 7 satellites (the counts where the rate is neither 0 nor 1): the measured LAMBDA fix
+    rate against the Monte Carlo ILS success rate of the same epochs' float covariances, and above the
+    bootstrapped lower bound, within the binomial 99 % interval."""
+    from simkit.attitude.experiments import fix_table
+
+    path = simkit.run("xian_static_bds", out=tmp_path / "x.h5", overrides=["scenario.duration_s=10800",
+                                                                           "imu.preset=ideal"])
+    with simkit.open(path) as ds:
+        rows = fix_table(ds, names=("attitude",), counts=(6, 7), every=30, n_samples=1000)
+    for r in rows:
+        assert r["epochs"] > 300
+        lo, hi = r["fix_ci95"]
+        width = (hi - lo) * 2.58 / 1.96 / 2
+        assert r["fix_rate"] - width <= r["ils_sr_mc"] <= r["fix_rate"] + width, r
+        assert r["bootstrap_sr"] <= r["fix_rate"] + width, r

@@ -15,15 +15,16 @@ from .solvers import SOLVER_NAMES, solver
 
 
 def fix_table(ds, names=("attitude", "attitude_c", "attitude_mc"), counts=(4, 5, 6, 7, 8, 9, 0), every=30,
-              progress=False, **params) -> list[dict]:
+              progress=False, n_samples=2000, **params) -> list[dict]:
     """Rows per (estimator, satellite count; 0 = all): epochs, fix rate (correct), wrong-fix rate, its binomial
-    95 % interval (Clopper-Pearson) and the mean bootstrapped success rate of the same epochs."""
+    95 % interval (Clopper-Pearson), the mean bootstrapped success rate of the same epochs and (LAMBDA) the
+    Monte Carlo ILS success rate of :func:`ils_prediction` with ``n_samples`` draws per epoch."""
     rows = []
     for name in names:
         if name not in SOLVER_NAMES:
             raise ValueError(f"names: {name!r}; expected some of {SOLVER_NAMES}")
         for count in counts:
-            p = {"ratio_threshold": 0.0, "max_sats": count, "every": every, **params}
+            p = {"ratio_threshold": 0.0, "max_sats": count, "every": every, "continuity": 0, **params}
             sol = solver(name)(ds, p, progress)
             st, n_sats = sol.extras["status"], sol.extras["n_sats"]
             use = (st >= 0) & ((n_sats == count) if count else True)
@@ -32,7 +33,8 @@ def fix_table(ds, names=("attitude", "attitude_c", "attitude_mc"), counts=(4, 5,
             rows.append({"estimator": name, "sats": count or "all", "epochs": n, "fix_rate": k / n if n else np.nan,
                          "wrong_fix_rate": (n - k) / n if n else np.nan, "fix_ci95": (lo, hi),
                          "bootstrap_sr": float(np.mean(sol.extras["success_rate"][use])) if n else np.nan,
-                         "ils_sr_mc": ils_prediction(ds, count, every, **params) if name == "attitude" else np.nan})
+                         "ils_sr_mc": ils_prediction(ds, count, every, n_samples=n_samples, **params)
+                         if name == "attitude" else np.nan})
     return rows
 
 
