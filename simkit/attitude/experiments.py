@@ -16,7 +16,8 @@ from .solvers import SOLVER_NAMES, solver
 
 def fix_table(ds, names=("attitude", "attitude_c", "attitude_mc"), counts=(4, 5, 6, 7, 8, 9, 0), every=30,
               progress=False, n_samples=2000, **params) -> list[dict]:
-    """Rows per (estimator, satellite count; 0 = all): epochs, fix rate (correct), wrong-fix rate, its binomial
+    """Rows per (estimator, satellite count; 0 = all): epochs, fix rate (correct), wrong-fix rate, searches that hit
+    the work cap (``not_finished``: neither), the fix rate's binomial
     95 % interval (Clopper-Pearson), the mean bootstrapped success rate of the same epochs and (LAMBDA) the
     Monte Carlo ILS success rate of :func:`ils_prediction` with ``n_samples`` draws per epoch."""
     rows = []
@@ -28,10 +29,10 @@ def fix_table(ds, names=("attitude", "attitude_c", "attitude_mc"), counts=(4, 5,
             sol = solver(name)(ds, p, progress)
             st, n_sats = sol.extras["status"], sol.extras["n_sats"]
             use = (st >= 0) & ((n_sats == count) if count else True)
-            k, n = int((st[use] == 1).sum()), int(use.sum())
+            k, n, w = int((st[use] == 1).sum()), int(use.sum()), int((st[use] == 3).sum())
             lo, hi = binomtest(k, n).proportion_ci(0.95) if n else (np.nan, np.nan)
             rows.append({"estimator": name, "sats": count or "all", "epochs": n, "fix_rate": k / n if n else np.nan,
-                         "wrong_fix_rate": (n - k) / n if n else np.nan, "fix_ci95": (lo, hi),
+                         "wrong_fix_rate": w / n if n else np.nan, "not_finished": n - k - w, "fix_ci95": (lo, hi),
                          "bootstrap_sr": float(np.mean(sol.extras["success_rate"][use])) if n else np.nan,
                          "ils_sr_mc": ils_prediction(ds, count, every, n_samples=n_samples, **params)
                          if name == "attitude" else np.nan})
@@ -55,10 +56,11 @@ def ils_prediction(ds, count, every=30, n_epochs=60, n_samples=2000, seed=0, **p
 
 def format_table(rows) -> str:
     """Markdown table of :func:`fix_table` rows."""
-    out = ["| estimator | satellites | epochs | fix rate | wrong-fix rate | fix rate 95 % CI | bootstrapped SR | "
-           "ILS SR (MC) |", "|---|---|---|---|---|---|---|---|"]
+    out = ["| estimator | satellites | epochs | fix rate | wrong-fix rate | not finished | fix rate 95 % CI | "
+           "bootstrapped SR | ILS SR (MC) |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lo, hi = r["fix_ci95"]
         out.append(f"| {r['estimator']} | {r['sats']} | {r['epochs']} | {r['fix_rate']:.4f} | "
-                   f"{r['wrong_fix_rate']:.4f} | {lo:.4f}-{hi:.4f} | {r['bootstrap_sr']:.4f} | {r['ils_sr_mc']:.4f} |")
+                   f"{r['wrong_fix_rate']:.4f} | {r['not_finished']} | {lo:.4f}-{hi:.4f} | {r['bootstrap_sr']:.4f} | "
+                   f"{r['ils_sr_mc']:.4f} |")
     return "\n".join(out)
