@@ -91,7 +91,8 @@ def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float 
     if method not in METHODS:
         raise AttitudeInputError("method", f"{method!r}; expected one of {', '.join(METHODS)}")
     stop = ratio_threshold if ratio_threshold > 0 else 1.0  # 1: stop once the best is proven
-    z, ratio, finished, rot, bounded = _search(grp, method, np.asarray(F, float), max_nodes, stop)
+    with np.errstate(divide="ignore", invalid="ignore"):  # an unfinished search has no 2nd cost: ratio NaN / inf
+        z, ratio, finished, rot, bounded = _search(grp, method, np.asarray(F, float), max_nodes, stop)
     sr = _success_rates(grp.Qa)
     accepted = finished & ((ratio >= ratio_threshold) | (ratio_threshold <= 0))
     b, Qb = conditioned(grp, z.astype(float))
