@@ -152,5 +152,22 @@ def test_fixed_failure_rate_ratio_test():
                 assert mu == 1.0
             decision = amb.ffrt(res, mu)
             if name == "large" and pf == "0.001":
-                continue  # borderline: ratio 0.475 between the table's mu 0.43 and our model-specific ~0.6
+                _large_borderline(res, Q, mu, want["mu"])
+                continue
             assert decision == want["accepted"], (name, pf, mu)
+
+
+def _large_borderline(res, Q, mu, table_mu):
+    """'large' at Pf = 0.001: its ratio (0.475) lies between the generic table's mu (0.430, reject) and ours
+    (~0.60, accept). The FF test's own definition decides: by Monte Carlo on this model, accepting every
+    solution with ratio <= 0.475 fails with probability ~3e-4 < 1e-3, so acceptance is within the tolerance,
+    and the table's mu (~2e-4) is conservative for this model (LAMBDA 3.0's table is fitted over many models)."""
+    rng = np.random.default_rng(11)
+    e = rng.standard_normal((30_000, Q.shape[0])) @ np.linalg.cholesky(Q).T
+    r = amb.ils_batch(e, Q, n_cands=2)
+    wrong = np.any(r.candidates[:, 0, :] != 0, axis=1)
+    ratios = r.sqnorms[:, 0] / r.sqnorms[:, 1]
+    case_ratio = res.sqnorms[0] / res.sqnorms[1]
+    assert table_mu < case_ratio < mu and amb.ffrt(res, mu)
+    assert np.mean(wrong & (ratios <= case_ratio)) < 1e-3
+    assert np.mean(wrong & (ratios <= table_mu)) < np.mean(wrong & (ratios <= mu))

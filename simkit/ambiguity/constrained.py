@@ -26,6 +26,8 @@ from .errors import AmbiguityInputError
 from .inner import rotation_fit, sphere_fit
 from .search import DEFAULT_MAX_NODES, Best, back_transform, make_search
 
+BOUNDED = 2  # status: search stopped with costs[found:] >= chi2 (a lower bound, see ratio_stop)
+
 
 class Epoch(NamedTuple):
     """One epoch's float solution (or K stacked along a leading axis), as the kernels take it."""
@@ -103,10 +105,12 @@ def _batch_solver(leaf_cost):
     search = make_search(leaf_cost)
 
     @njit
-    def solve_epoch(ep, F, lengths, max_nodes, best, cands):
+    def solve_epoch(ep, F, lengths, max_nodes, best, cands, ratio_stop):
         """Decorrelate, then search-and-expand: a first leaf far off the constraint would make search-and-shrink
         start from a huge ellipsoid, so search below chi2 and expand it until m candidates are inside (then
-        they are the m best). Writes ``best`` and ``cands`` (m, n) int64; returns (status, i, j, nodes)."""
+        they are the m best). With ``ratio_stop`` > 0 the expansion also stops once the ellipsoid reaches
+        ratio_stop x the best cost: the costs not found are then at least chi2, which is stored in their place
+        (status BOUNDED). Writes ``best`` and ``cands`` (m, n) int64; returns (status, i, j, nodes)."""
         w = new_decorrelated(ep.a_hat.shape[0])
         code, i, j = prepare(ep.a_hat, ep.Qa, w)
         if code != OK:
@@ -121,12 +125,16 @@ def _batch_solver(leaf_cost):
             total += nodes
             if found == best.costs.shape[0] or status != OK or total >= max_nodes:
                 break
+            if found >= 1 and ratio_stop > 0.0 and chi2 >= ratio_stop * best.costs[0]:
+                best.costs[found:] = chi2
+                status = BOUNDED
+                break
             chi2 *= 4.0
         cands[:, :] = back_transform(best.cands, w.Zti, w.shift)
         return status, 0, 0, total
 
     @njit
-    def solve_batch(eps, F, lengths, m, max_nodes, k_out):
+    def solve_batch(eps, F, lengths, m, max_nodes, k_out, ratio_stop):
         """Every epoch of the stacked ``eps``, ``lengths`` (K, r): (cands, costs, sols, status, nodes, err)."""
         K, n = eps.a_hat.shape
         cands = np.zeros((K, m, n), dtype=np.int64)
@@ -139,7 +147,7 @@ def _batch_solver(leaf_cost):
         for k in range(K):
             ep = Epoch(eps.a_hat[k], eps.Qa[k], eps.b_hat[k], eps.Qb[k], eps.Qba[k])
             best = Best(cz, costs[k], sols[k])
-            code, i, j, nodes[k] = solve_epoch(ep, F, lengths[k], max_nodes, best, cands[k])
+            code, i, j, nodes[k] = solve_epoch(ep, F, lengths[k], max_nodes, best, cands[k], ratio_stop)
             status[k] = code
             if code < 0 and err[0] < 0:
                 err[0], err[1], err[2] = k, i, j
@@ -154,28 +162,32 @@ _solve_attitude = _batch_solver(attitude_leaf)
 
 # One cached entry kernel per constraint, so that each compiles (and loads) only its own inner problem.
 @njit(cache=True)
-def _length_batch(eps, F, lengths, m, max_nodes):
-    return _solve_length(eps, F, lengths, m, max_nodes, 3)
+def _length_batch(eps, F, lengths, m, max_nodes, ratio_stop):
+    return _solve_length(eps, F, lengths, m, max_nodes, 3, ratio_stop)
 
 
 @njit(cache=True)
-def _attitude_batch(eps, F, lengths, m, max_nodes):
-    return _solve_attitude(eps, F, lengths, m, max_nodes, 9)
+def _attitude_batch(eps, F, lengths, m, max_nodes, ratio_stop):
+    return _solve_attitude(eps, F, lengths, m, max_nodes, 9, ratio_stop)
 
 
 class ConstrainedResult:
     """Constrained ILS for K epochs: ``candidates`` (K, n_cands, n) int64 best first, ``costs`` (K, n_cands)
     (squared ambiguity norm plus the inner minimum), ``finished`` (K,) bool, ``nodes`` (K,); for one baseline
     ``baselines`` (K, n_cands, 3) m on the sphere |b| = l; for several, ``rotations`` (K, n_cands, 3, 3) body ->
-    local frame, and ``baselines`` (K, n_cands, 3, r) = R F. Single-epoch calls drop the leading K axis."""
+    local frame, and ``baselines`` (K, n_cands, 3, r) = R F. Single-epoch calls drop the leading K axis.
+    ``bounded`` (K,) bool: the search stopped early under ``ratio_stop``; then ``costs`` of the candidates not
+    found hold a lower bound of their cost (so ``costs[1] / costs[0]`` is a lower bound of the ratio), and their
+    ``candidates`` rows are not meaningful. ``finished`` is True for bounded epochs (their best is exact)."""
 
-    def __init__(self, candidates, costs, finished, nodes, baselines, rotations=None):
+    def __init__(self, candidates, costs, finished, nodes, baselines, rotations=None, bounded=None):
         self.candidates, self.costs, self.finished, self.nodes = candidates, costs, finished, nodes
         self.baselines, self.rotations = baselines, rotations
+        self.bounded = np.zeros_like(finished, dtype=bool) if bounded is None else bounded
 
     @property
     def status(self):
-        return np.where(self.finished, "finished", "not finished")
+        return np.where(self.bounded, "bounded", np.where(self.finished, "finished", "not finished"))
 
 
 def _stack(x, ndim, what, K=None):
@@ -203,29 +215,35 @@ def _epochs(a_hat, Qa, b_hat, Qb, Qba) -> Epoch:
     return ep
 
 
-def _run(kernel, ep, single, F, lengths, n_cands, max_nodes):
+def _run(kernel, ep, single, F, lengths, n_cands, max_nodes, ratio_stop=0.0):
     """Run ``kernel`` (:func:`_length_batch` or :func:`_attitude_batch`) and wrap its output; ``lengths`` (K, r)."""
     if int(n_cands) != n_cands or n_cands < 1:
         raise AmbiguityInputError("n_cands", f"{n_cands!r}; expected an integer >= 1")
-    cands, costs, sols, status, nodes, err = kernel(ep, F, lengths, int(n_cands), int(max_nodes))
+    cands, costs, sols, status, nodes, err = kernel(ep, F, lengths, int(n_cands), int(max_nodes), float(ratio_stop))
     if err[0] >= 0:
         if err[1] < 0:
             raise AmbiguityInputError(f"Qb[{err[0]}]", "conditional baseline covariance is not positive definite")
         raise AmbiguityInputError(f"Qa[{int(err[0])}]", "not symmetric positive definite (or a_hat not finite)")
-    finished = status == OK
+    finished, bounded = (status == OK) | (status == BOUNDED), status == BOUNDED
     if kernel is _length_batch:
-        res = ConstrainedResult(cands, costs, finished, nodes, sols)
+        res = ConstrainedResult(cands, costs, finished, nodes, sols, None, bounded)
     else:
         R = sols.reshape(len(cands), -1, 3, 3)
-        res = ConstrainedResult(cands, costs, finished, nodes, R @ F, R)
+        res = ConstrainedResult(cands, costs, finished, nodes, R @ F, R, bounded)
     if single:
         res = ConstrainedResult(res.candidates[0], res.costs[0], bool(res.finished[0]), int(res.nodes[0]),
-                                res.baselines[0], None if res.rotations is None else res.rotations[0])
+                                res.baselines[0], None if res.rotations is None else res.rotations[0],
+                                bool(res.bounded[0]))
     return res
 
 
-def baseline_constrained_ils(a_hat, Qa, b_hat, Qb, Qba, length, n_cands=2, max_nodes=DEFAULT_MAX_NODES):
+def baseline_constrained_ils(a_hat, Qa, b_hat, Qb, Qba, length, n_cands=2, max_nodes=DEFAULT_MAX_NODES,
+                             ratio_stop=0.0):
     """C-LAMBDA: ambiguities and baseline for one baseline of known ``length`` (m).
+
+    ``ratio_stop`` > 0: stop looking for the 2nd..n_cands-th candidates once the cost bound reaches ratio_stop x
+    the best cost (``bounded``; their costs are then lower bounds), which is all a ratio test at that threshold
+    needs and avoids enumerating a huge ellipsoid when the best candidate is far better than any other.
 
     Shapes per epoch: ``a_hat`` (n,) cycles, ``Qa`` (n, n), ``b_hat`` (3,) m, ``Qb`` (3, 3), ``Qba`` (3, n); stack
     them over a leading K axis for a batch (``length`` scalar or (K,)). Returns :class:`ConstrainedResult`.
@@ -240,19 +258,21 @@ def baseline_constrained_ils(a_hat, Qa, b_hat, Qb, Qba, length, n_cands=2, max_n
     if lengths.shape not in ((1,), (K,)):
         raise AmbiguityInputError("length", f"shape {lengths.shape}; expected a scalar or ({K},), one per epoch")
     lengths = np.ascontiguousarray(np.broadcast_to(lengths[:, None], (K, 1)))
-    return _run(_length_batch, ep, np.ndim(a_hat) == 1, np.zeros((3, 1)), lengths, n_cands, max_nodes)
+    return _run(_length_batch, ep, np.ndim(a_hat) == 1, np.zeros((3, 1)), lengths, n_cands, max_nodes, ratio_stop)
 
 
-def attitude_constrained_ils(a_hat, Qa, b_hat, Qb, Qba, body_baselines, n_cands=2, max_nodes=DEFAULT_MAX_NODES):
+def attitude_constrained_ils(a_hat, Qa, b_hat, Qb, Qba, body_baselines, n_cands=2, max_nodes=DEFAULT_MAX_NODES,
+                             ratio_stop=0.0):
     """Multivariate constrained LAMBDA: ambiguities and attitude R (body -> local) for r baselines.
 
     ``body_baselines`` (3, r): the baselines in the body frame (m). Per epoch: ``a_hat`` (r n,) stacked by
     baseline, ``Qa`` (r n, r n), ``b_hat`` (3 r,), ``Qb`` (3 r, 3 r), ``Qba`` (3 r, r n); stack over K for a batch.
     The inner minimum over SO(3) starts from the orthogonal Procrustes solution and is refined by Gauss-Newton.
+    ``ratio_stop``: as in :func:`baseline_constrained_ils`.
     """
     F = np.ascontiguousarray(body_baselines, dtype=np.float64)
     if F.ndim != 2 or F.shape[0] != 3 or np.shape(b_hat)[-1] != 3 * F.shape[1]:
         raise AmbiguityInputError("body_baselines", f"shape {F.shape}; expected (3, r) with b_hat of 3 r values")
     ep = _epochs(a_hat, Qa, b_hat, Qb, Qba)
     lengths = np.ascontiguousarray(np.broadcast_to(np.linalg.norm(F, axis=0), (ep.a_hat.shape[0], F.shape[1])))
-    return _run(_attitude_batch, ep, np.ndim(a_hat) == 1, F, lengths, n_cands, max_nodes)
+    return _run(_attitude_batch, ep, np.ndim(a_hat) == 1, F, lengths, n_cands, max_nodes, ratio_stop)

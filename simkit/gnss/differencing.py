@@ -11,6 +11,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import SimkitError
+
+
+class DifferencingInputError(SimkitError, ValueError):
+    """An array given to the differencing functions has the wrong shape (names the argument)."""
+
+    exit_code = 2
+
+
+def _obs(x, what: str = "x") -> np.ndarray:
+    """``x`` as a float (M, A, S) array, or a :class:`DifferencingInputError` naming ``what``."""
+    arr = np.asarray(x, dtype=float)
+    if arr.ndim != 3:
+        raise DifferencingInputError(f"{what}: shape {arr.shape}; expected (M, A, S) (epochs, antennas, satellites)")
+    return arr
+
 
 def systems_of(sat_ids) -> np.ndarray:
     """System letter per satellite ("G", "C", ...), (S,) array of str."""
@@ -19,6 +35,9 @@ def systems_of(sat_ids) -> np.ndarray:
 
 def single_difference(x: np.ndarray, ref_antenna: int = 0) -> np.ndarray:
     """Between-antenna single differences (M, A-1, S): every other antenna minus ``ref_antenna``."""
+    x = _obs(x)
+    if not 0 <= ref_antenna < x.shape[1]:
+        raise DifferencingInputError(f"ref_antenna: {ref_antenna}; expected 0 .. {x.shape[1] - 1}")
     others = [a for a in range(x.shape[1]) if a != ref_antenna]
     return x[:, others, :] - x[:, ref_antenna:ref_antenna + 1, :]
 
@@ -43,6 +62,10 @@ def reference_satellites(elevation: np.ndarray, valid: np.ndarray, sat_ids) -> n
 
 def double_difference(x: np.ndarray, ref_sat: np.ndarray, ref_antenna: int = 0) -> np.ndarray:
     """Double differences (M, A-1, S); NaN at each system's reference satellite and where untracked."""
+    x = _obs(x)
+    if np.shape(ref_sat) != (x.shape[0], x.shape[2]):
+        raise DifferencingInputError(f"ref_sat: shape {np.shape(ref_sat)}; expected (M, S) = "
+                                     f"{(x.shape[0], x.shape[2])} for x of shape (M, A, S) = {x.shape}")
     sd = single_difference(x, ref_antenna)
     m = np.arange(x.shape[0])[:, None]
     ref_vals = sd[m, :, np.clip(ref_sat, 0, None)].transpose(0, 2, 1)  # (M, A-1, S)

@@ -1,0 +1,17 @@
+"""Multi-antenna carrier-phase attitude from a simkit file: DD float solution, ambiguity resolution (LAMBDA,
+C-LAMBDA, MC-LAMBDA) with validation, attitude from the fixed baselines with covariance, and TDCP velocity.
+
+``SOLVERS``: name -> ``callable(ds, params, progress) -> simkit.solution.Solution`` for ``simkit solve``.
+See docs/attitude.md.
+"""
+from .dd import FloatGroup, Observations, float_solution
+from .errors import AttitudeInputError
+from .resolve import METHODS, Resolution, resolve
+from .solvers import build_registry
+from .wahba import atdop, badshah_eq10, euler_covariance, phi_covariance, single_baseline, wahba_svd
+
+SOLVERS = build_registry()
+
+__all__ = ["AttitudeInputError", "FloatGroup", "METHODS", "Observations", "Resolution", "SOLVERS", "atdop",
+           "badshah_eq10", "euler_covariance", "float_solution", "phi_covariance", "resolve", "single_baseline",
+           "wahba_svd"]

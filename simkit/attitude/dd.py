@@ -1,0 +1,172 @@
+"""Per-epoch double-differenced float solution of r baselines (antenna k against antenna 0), arrays in and out.
+
+Model for baseline k, signal g, satellite s with reference satellite ref(s) of its system (Wang 2018 eq 16 with
+the baseline in ENU): lambda_g DD(phi) = -(e_s - e_ref) . b_k + lambda_g a_k,s + noise (m), DD(code) = -(e_s -
+e_ref) . b_k + noise (m), e the unit line of sight receiver -> satellite in ENU. The float baseline comes from the
+code (the carrier carries a free ambiguity per row), the float ambiguities from the carrier minus it:
+
+    b_hat = (G' Wp G)^-1 G' Wp y_p,  a_hat = L^-1 (y_phi - G b_hat),
+    Qb = (G' Wp G)^-1,  Qa = L^-1 (Qphi + G Qb G') L^-1,  Qba = -Qb G' L^-1,
+
+with G = I_r (x) G_1 (baseline-major rows) and Qphi, Qp = D diag(sigma^2) D' from the undifferenced variances
+(so the rows of different baselines that share antenna 0 are correlated, as they are). Epochs are grouped by
+their channel pattern (which satellites / references / signals); every group is solved in one batch.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..gnss.differencing import systems_of
+from .errors import AttitudeInputError
+
+
+@dataclass(frozen=True)
+class Observations:
+    """What the float solution reads, G signals, M epochs, A antennas, S satellites (NaN where not tracked).
+
+    ``carrier`` (G, M, A, S) cycles; ``code`` (G, M, A, S) m; ``var_carrier`` / ``var_code`` (G, M, A, S) m^2
+    undifferenced variances; ``wavelength`` (G,) m; ``los`` (M, S, 3) unit lines of sight receiver -> satellite
+    in ENU; ``elevation`` (M, S) rad; ``sat_ids`` (S,) str (the system is the first letter).
+    """
+
+    carrier: np.ndarray
+    code: np.ndarray
+    var_carrier: np.ndarray
+    var_code: np.ndarray
+    wavelength: np.ndarray
+    los: np.ndarray
+    elevation: np.ndarray
+    sat_ids: np.ndarray
+
+    def __post_init__(self):
+        shape = np.shape(self.carrier)
+        if len(shape) != 4:
+            raise AttitudeInputError("carrier", f"shape {shape}; expected (G, M, A, S)")
+        for name in ("code", "var_carrier", "var_code"):
+            if np.shape(getattr(self, name)) != shape:
+                raise AttitudeInputError(name, f"shape {np.shape(getattr(self, name))}; expected {shape}")
+        g, m, a, s = shape
+        if a < 2:
+            raise AttitudeInputError("carrier", f"{a} antenna(s); expected at least 2 (one baseline)")
+        for name, want in (("wavelength", (g,)), ("los", (m, s, 3)), ("elevation", (m, s)), ("sat_ids", (s,))):
+            if np.shape(getattr(self, name)) != want:
+                raise AttitudeInputError(name, f"shape {np.shape(getattr(self, name))}; expected {want}")
+
+
+@dataclass(frozen=True)
+class FloatGroup:
+    """The float solutions of K epochs sharing one channel pattern; n channels per baseline, r baselines.
+
+    ``epochs`` (K,) indices into the M epochs; ``signal``, ``sat``, ``ref`` (n,) of each channel; ``a_hat`` (K, r n)
+    cycles (baseline-major); ``Qa`` (K, r n, r n) cycles^2; ``b_hat`` (K, 3 r) m ENU; ``Qb`` (K, 3 r, 3 r) m^2;
+    ``Qba`` (K, 3 r, r n) m cycles; ``G`` (K, n, 3) DD geometry (m per m of baseline); ``Qphi`` (K, r n, r n)
+    DD carrier covariance m^2.
+    """
+
+    epochs: np.ndarray
+    signal: np.ndarray
+    sat: np.ndarray
+    ref: np.ndarray
+    a_hat: np.ndarray
+    Qa: np.ndarray
+    b_hat: np.ndarray
+    Qb: np.ndarray
+    Qba: np.ndarray
+    G: np.ndarray
+    Qphi: np.ndarray
+
+
+def channel_masks(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None) -> np.ndarray:
+    """Usable (G, M, S): carrier and code on every antenna, elevation >= ``mask_rad``, and, with ``max_sats``,
+    only the ``max_sats`` highest satellites of each epoch (counted over all systems, references included)."""
+    ok = np.isfinite(obs.carrier).all(2) & np.isfinite(obs.code).all(2)
+    ok &= (np.nan_to_num(obs.elevation, nan=-np.inf) >= mask_rad)[None]
+    if max_sats is not None:
+        el = np.where(ok.any(0), obs.elevation, -np.inf)
+        rank = np.argsort(np.argsort(-el, axis=1), axis=1)
+        ok &= (rank < max_sats)[None]
+    return ok
+
+
+def references(obs: Observations, usable: np.ndarray) -> np.ndarray:
+    """Reference satellite (G, M, S) int of each signal, epoch and satellite's system (highest usable
+    elevation), -1 where the system has fewer than 2 usable satellites."""
+    sys = systems_of(obs.sat_ids)
+    ref = np.full(usable.shape, -1, dtype=np.int64)
+    for letter in np.unique(sys):
+        cols = np.flatnonzero(sys == letter)
+        el = np.where(usable[:, :, cols], obs.elevation[None, :, cols], -np.inf)
+        best = cols[np.argmax(el, axis=2)]  # (G, M)
+        enough = usable[:, :, cols].sum(2) >= 2
+        ref[:, :, cols] = np.where(enough, best, -1)[..., None]
+    return ref
+
+
+def dd_operator(signal, sat, ref, n_ant: int, n_sat: int, n_sig: int) -> np.ndarray:
+    """D (r n, G A S) with DD = D x for x (G, A, S) flattened; rows baseline-major, then channel."""
+    n, r = len(sat), n_ant - 1
+    D = np.zeros((r, n, n_sig, n_ant, n_sat))
+    c = np.arange(n)
+    for k in range(1, n_ant):
+        for a, sign in ((k, 1.0), (0, -1.0)):
+            np.add.at(D[k - 1], (c, signal, a, sat), sign)
+            np.add.at(D[k - 1], (c, signal, a, ref), -sign)
+    return D.reshape(r * n, n_sig * n_ant * n_sat)
+
+
+def _patterns(usable, ref):
+    """Epoch groups (list of (epochs, signal, sat, ref)) with the same channels and references."""
+    g, m, s = usable.shape
+    chan = usable & (ref >= 0) & (ref != np.arange(s))
+    key = np.concatenate([chan.transpose(1, 0, 2).reshape(m, -1), ref.transpose(1, 0, 2).reshape(m, -1)], 1)
+    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
+    groups = []
+    for u in range(len(uniq)):
+        epochs = np.flatnonzero(inverse.reshape(-1) == u)
+        sig, sat = np.nonzero(chan[:, epochs[0], :])
+        if len(sat) >= 3:
+            groups.append((epochs, sig, sat, ref[sig, epochs[0], sat]))
+    return groups
+
+
+def float_solution(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None) -> list[FloatGroup]:
+    """Float DD solutions of every epoch with at least 3 DD channels, grouped by channel pattern."""
+    usable = channel_masks(obs, mask_rad, max_sats)
+    ref = references(obs, usable)
+    return [_solve_group(obs, *grp) for grp in _patterns(usable, ref)]
+
+
+def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:
+    """Batch least squares of one channel pattern (see the module docstring)."""
+    n_ant = obs.carrier.shape[2]
+    r, n = n_ant - 1, len(sat)
+    sigs, sig_i = np.unique(signal, return_inverse=True)
+    cols, col_i = np.unique(np.concatenate([sat, ref]), return_inverse=True)  # only the satellites used
+    D = dd_operator(sig_i, col_i[:n], col_i[n:], n_ant, len(cols), len(sigs))
+    lam = np.tile(obs.wavelength[signal], r)  # (r n,)
+
+    def take(x):  # (G, M, A, S) -> (K, G' A S') in the column order of D
+        sub = x[sigs[:, None], epochs[None, :]][..., cols]
+        return np.nan_to_num(sub.transpose(1, 0, 2, 3).reshape(len(epochs), -1))
+
+    y_phi = (take(obs.carrier) * np.repeat(obs.wavelength[sigs], n_ant * len(cols))) @ D.T
+    y_p = take(obs.code) @ D.T
+    Qphi = np.einsum("ij,kj,lj->kil", D, take(obs.var_carrier), D, optimize=True)
+    Qp = np.einsum("ij,kj,lj->kil", D, take(obs.var_code), D, optimize=True)
+    e = obs.los[epochs]
+    G1 = -(e[:, sat, :] - e[:, ref, :])  # (K, n, 3)
+    G = np.zeros((len(epochs), r * n, 3 * r))
+    for k in range(r):
+        G[:, k * n:(k + 1) * n, 3 * k:3 * k + 3] = G1
+    GtW = np.swapaxes(np.linalg.solve(Qp, G), 1, 2)  # G' Qp^-1
+    Qb = np.linalg.inv(GtW @ G)
+    Qb = 0.5 * (Qb + np.swapaxes(Qb, 1, 2))
+    b_hat = np.einsum("kij,kj->ki", Qb @ GtW, y_p)
+    a_hat = (y_phi - np.einsum("kij,kj->ki", G, b_hat)) / lam
+    GQb = G @ Qb
+    Qa = (Qphi + GQb @ np.swapaxes(G, 1, 2)) / np.outer(lam, lam)
+    Qa = 0.5 * (Qa + np.swapaxes(Qa, 1, 2))
+    Qba = -np.swapaxes(GQb, 1, 2) / lam
+    return FloatGroup(epochs, signal, sat, ref, a_hat, Qa, b_hat, Qb, Qba, G1, Qphi)

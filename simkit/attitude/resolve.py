@@ -1,0 +1,188 @@
+"""Ambiguity resolution of a group of float epochs: ILS (LAMBDA), C-LAMBDA per baseline, MC-LAMBDA, with
+validation (ratio test), partial fixing (LAMBDA) and the bootstrapped success rate per epoch.
+
+Cycles for ambiguities, metres (ENU) for baselines. ``ratio`` = second-best cost / best cost (>= 1), the
+squared norm for ILS and the constrained cost for C-/MC-LAMBDA.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import ambiguity as amb
+from .dd import FloatGroup
+from .errors import AttitudeInputError
+
+METHODS = ("lambda", "clambda", "mclambda")
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Per epoch of a group (K epochs, r baselines, n channels per baseline).
+
+    ``z`` (K, r n) float cycles, the best integer candidate (NaN for partial fixes); ``ratio`` (K,); ``accepted``
+    (K,) bool; ``partial`` (K,) bool (a subset fixed); ``success_rate`` (K,) bootstrapped (of Qa, decorrelated);
+    ``finished`` (K,) bool (the search completed within its work cap; ``bounded`` (K,) bool: the constrained
+    search stopped once the ratio was known to pass, so ``ratio`` is a lower bound); ``b`` (K, 3 r) m ENU
+    baselines given the fix (float where nothing was accepted); ``Qb`` (K, 3 r, 3 r) m^2; ``rotation`` (K, 3, 3) body -> ENU of
+    MC-LAMBDA (NaN otherwise); ``z_check`` (K, p) the fixed combinations and ``Z`` (K, r n, p) the integer maps
+    (z_check = Z' a for the true a when right) used to label wrong fixes, p = r n for full fixes.
+    """
+
+    z: np.ndarray
+    ratio: np.ndarray
+    accepted: np.ndarray
+    partial: np.ndarray
+    success_rate: np.ndarray
+    finished: np.ndarray
+    b: np.ndarray
+    Qb: np.ndarray
+    rotation: np.ndarray
+    z_check: list
+    Z: list
+    bounded: np.ndarray
+
+
+def conditioned(grp: FloatGroup, z: np.ndarray):
+    """Baselines (K, 3 r) and covariance (K, 3 r, 3 r) given integer ambiguities z (K, r n)."""
+    K = np.swapaxes(np.linalg.solve(grp.Qa, np.swapaxes(grp.Qba, 1, 2)), 1, 2)  # Qba Qa^-1
+    b = grp.b_hat - np.einsum("kij,kj->ki", K, grp.a_hat - z)
+    Qb = grp.Qb - K @ np.swapaxes(grp.Qba, 1, 2)
+    return b, 0.5 * (Qb + np.swapaxes(Qb, 1, 2))
+
+
+def _search(grp: FloatGroup, method: str, F: np.ndarray, max_nodes: int, stop: float):
+    """(best z (K, r n) int, ratio (K,), finished (K,), rotation (K, 3, 3) or NaN, bounded (K,)): constrained
+    searches stop once the 2nd cost is known to be >= ``stop`` x the best (``bounded``: ratio is a lower bound)."""
+    Kn, rn = grp.a_hat.shape
+    r = F.shape[1]
+    rot = np.full((Kn, 3, 3), np.nan)
+    if method == "lambda":
+        res = amb.ils_batch(grp.a_hat, grp.Qa, n_cands=2, max_nodes=max_nodes)
+        return res.candidates[:, 0], res.sqnorms[:, 1] / res.sqnorms[:, 0], res.finished, rot, np.zeros(Kn, bool)
+    if method == "clambda":
+        n = rn // r
+        z = np.zeros((Kn, rn), dtype=np.int64)
+        ratio, finished, bounded = np.full(Kn, np.inf), np.ones(Kn, bool), np.zeros(Kn, bool)
+        for k in range(r):
+            a, s = slice(k * n, (k + 1) * n), slice(3 * k, 3 * k + 3)
+            res = amb.baseline_constrained_ils(grp.a_hat[:, a], grp.Qa[:, a, a], grp.b_hat[:, s], grp.Qb[:, s, s],
+                                               grp.Qba[:, s, a], np.linalg.norm(F[:, k]), n_cands=2,
+                                               max_nodes=max_nodes, ratio_stop=stop)
+            z[:, a] = res.candidates[:, 0]
+            ratio = np.minimum(ratio, res.costs[:, 1] / res.costs[:, 0])
+            finished &= res.finished
+            bounded |= res.bounded
+        return z, ratio, finished, rot, bounded
+    res = amb.attitude_constrained_ils(grp.a_hat, grp.Qa, grp.b_hat, grp.Qb, grp.Qba, F, n_cands=2,
+                                       max_nodes=max_nodes, ratio_stop=stop)
+    return res.candidates[:, 0], res.costs[:, 1] / res.costs[:, 0], res.finished, res.rotations[:, 0], res.bounded
+
+
+def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float = 3.0, partial_p0=None,
+            max_nodes: int = amb.DEFAULT_MAX_NODES) -> Resolution:
+    """Fix the ambiguities of ``grp`` with ``method`` (one of :data:`METHODS`); ``F`` (3, r) body baselines m.
+
+    Accept when ratio >= ``ratio_threshold`` (0 accepts every finished search) and the search finished; with
+    ``partial_p0`` (LAMBDA only) epochs that fail the test fix the largest decorrelated subset whose
+    bootstrapped success rate is >= partial_p0.
+    """
+    if method not in METHODS:
+        raise AttitudeInputError("method", f"{method!r}; expected one of {', '.join(METHODS)}")
+    stop = ratio_threshold if ratio_threshold > 0 else 1.0  # 1: stop once the best is proven
+    with np.errstate(divide="ignore", invalid="ignore"):  # an unfinished search has no 2nd cost: ratio NaN / inf
+        z, ratio, finished, rot, bounded = _search(grp, method, np.asarray(F, float), max_nodes, stop)
+    sr = _success_rates(grp.Qa)
+    accepted = finished & ((ratio >= ratio_threshold) | (ratio_threshold <= 0))
+    b, Qb = conditioned(grp, z.astype(float))
+    b = np.where(accepted[:, None], b, grp.b_hat)
+    Qb = np.where(accepted[:, None, None], Qb, grp.Qb)
+    zf = np.where(accepted[:, None], z.astype(float), np.nan)
+    eye = np.eye(z.shape[1], dtype=np.int64)
+    z_check = [z[i] if accepted[i] else z[i, :0] for i in range(len(z))]
+    Zs = [eye if accepted[i] else eye[:, :0] for i in range(len(z))]
+    partial = np.zeros(len(z), bool)
+    if partial_p0 is not None and method == "lambda":
+        _partial(grp, partial_p0, accepted, partial, b, Qb, z_check, Zs)
+    return Resolution(zf, ratio, accepted, partial, np.asarray(sr, float).reshape(-1), finished, b, Qb, rot,
+                      z_check, Zs, bounded)
+
+
+def _success_rates(Qa: np.ndarray) -> np.ndarray:
+    """Bootstrapped success rate (K,) after decorrelation."""
+    d = amb.ils_batch(np.zeros(Qa.shape[:2]), Qa, n_cands=1).d
+    return amb.bootstrap_success_rate(d=d)
+
+
+def _partial(grp, p0, accepted, partial, b, Qb, z_check, Zs):
+    """Partial fixes of the rejected epochs, in place (baselines conditioned on the fixed combinations)."""
+    for i in np.flatnonzero(~accepted):
+        pf = amb.partial_fix(grp.a_hat[i], grp.Qa[i], p0=p0)
+        if pf.n_fixed == 0:
+            continue
+        Z = pf.Z_fixed.astype(float)
+        Qz = Z.T @ grp.Qa[i] @ Z
+        K = grp.Qba[i] @ Z @ np.linalg.inv(Qz)
+        b[i] = grp.b_hat[i] - K @ (Z.T @ grp.a_hat[i] - pf.z_fixed)
+        Qb[i] = grp.Qb[i] - K @ Z.T @ grp.Qba[i].T
+        partial[i] = True
+        z_check[i], Zs[i] = pf.z_fixed, pf.Z_fixed
+
+
+def subset(grp: FloatGroup, idx: np.ndarray) -> FloatGroup:
+    """The epochs ``idx`` (indices into the group) of ``grp``."""
+    return FloatGroup(grp.epochs[idx], grp.signal, grp.sat, grp.ref, *(getattr(grp, f)[idx] for f in
+                      ("a_hat", "Qa", "b_hat", "Qb", "Qba", "G", "Qphi")))
+
+
+def _first_fixes(grp, breaks, method, F, kw):
+    """Search run by run (a run: epochs between continuity breaks) until each run has an accepted fix; chunks
+    double (1, 2, 4, ... epochs per run) so a run that never fixes costs O(log) calls. Returns (searched
+    {epoch: (Resolution, row)}, first accepted epoch per run or -1, run id per epoch)."""
+    run = np.cumsum(breaks) - 1
+    starts, ends = np.flatnonzero(breaks), np.append(np.flatnonzero(breaks)[1:], len(breaks))
+    first = np.full(len(starts), -1)
+    pos, step, searched = starts.copy(), 1, {}
+    pending = np.arange(len(starts))
+    while pending.size:
+        idx = np.concatenate([np.arange(pos[q], min(pos[q] + step, ends[q])) for q in pending])
+        res = resolve(subset(grp, idx), method, F, **kw)
+        for row, i in enumerate(idx):
+            searched[i] = (res, row)
+        acc = idx[res.accepted]
+        for q in pending:
+            hit = acc[(acc >= pos[q]) & (acc < ends[q])]
+            first[q] = hit.min() if hit.size else -1
+        pos[pending] += step
+        pending = pending[(first[pending] < 0) & (pos[pending] < ends[pending])]
+        step *= 2
+    return searched, first, run
+
+
+def resolve_held(grp: FloatGroup, method: str, F: np.ndarray, breaks: np.ndarray, **kw) -> Resolution:
+    """:func:`resolve` with ambiguity continuity: after the first accepted fix of a run of epochs without a
+    break (``breaks`` (K,) bool: a gap in the epochs or a loss-of-lock flag on any channel used), the later
+    epochs of the run keep that fix (their ``ratio`` is NaN: not searched). Epochs before it are searched."""
+    searched, first, run = _first_fixes(grp, np.asarray(breaks, bool), method, F, kw)
+    K = len(run)
+    fields = {f: [] for f in ("z", "ratio", "accepted", "partial", "finished", "rotation", "bounded")}
+    z_check, Zs, b, Qb = [None] * K, [None] * K, grp.b_hat.copy(), grp.Qb.copy()
+    held = (first[run] >= 0) & (np.arange(K) > first[run])
+    zh = np.zeros(grp.a_hat.shape)
+    for i in range(K):
+        src, row = searched[first[run[i]]] if held[i] else searched[i]
+        for f in fields:
+            fields[f].append(getattr(src, f)[row])
+        z_check[i], Zs[i] = src.z_check[row], src.Z[row]
+        zh[i] = src.z[row]
+        if not held[i]:
+            b[i], Qb[i] = src.b[row], src.Qb[row]
+    if held.any():
+        bh, Qh = conditioned(subset(grp, held), zh[held])
+        b[held], Qb[held] = bh, Qh
+    out = {f: np.array(v) for f, v in fields.items()}
+    out["ratio"][held] = np.nan
+    out["rotation"][held] = np.nan
+    return Resolution(out["z"], out["ratio"], out["accepted"], out["partial"], _success_rates(grp.Qa),
+                      out["finished"], b, Qb, out["rotation"], z_check, Zs, out["bounded"])

@@ -1,0 +1,197 @@
+"""simkit.attitude pieces on arrays, against closed forms and independent constructions (no file)."""
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from simkit import ambiguity as amb
+from simkit.attitude import (AttitudeInputError, Observations, atdop, badshah_eq10, float_solution,
+                             phi_covariance, resolve, single_baseline, wahba_svd)
+from simkit.attitude.tdcp import tdcp_velocity
+from simkit.attitude.wahba import propagated_covariance, wahba_wls
+from simkit.frames import attitude_from_euler, euler_from_attitude
+from simkit.gnss import differencing
+
+LAM = 0.19029367  # GPS L1 wavelength, m
+F = np.array([[0.0, 1.2], [1.5, 0.0], [0.0, 0.1]])  # body baselines (3, 2): forward and right, m
+
+
+def _sky(rng, m, s, min_el=15.0):
+    az = rng.uniform(0, 2 * np.pi, (1, s)) + np.linspace(0, 0.01, m)[:, None]
+    el = np.radians(rng.uniform(min_el, 85.0, (1, s))) + np.zeros((m, 1))
+    los = np.stack([np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.sin(el)], -1)
+    return los, el
+
+
+def _obs(rng, R, m=40, s=8, sig_phi=0.002, sig_p=0.2):
+    """Synthetic single-signal observations for antennas at R @ [0, f_1, f_2] (ENU), with true integers N."""
+    los, el = _sky(rng, m, s)
+    pos = np.concatenate([np.zeros((m, 1, 3)), np.broadcast_to((R @ F).T, (m, 2, 3))], axis=1)  # (M, A, 3)
+    rng_m = -np.einsum("msi,mai->mas", los, pos) + 2.0e7
+    N = rng.integers(-1000, 1000, (1, 3, s)) + np.zeros((m, 1, 1), int)
+    carrier = (rng_m + sig_phi * rng.standard_normal(rng_m.shape)) / LAM + N
+    code = rng_m + sig_p * rng.standard_normal(rng_m.shape)
+    ones = np.ones((1,) + rng_m.shape)
+    obs = Observations(carrier[None], code[None], sig_phi ** 2 * ones, sig_p ** 2 * ones, np.array([LAM]), los,
+                       el, np.array([f"G{i + 1:02d}" for i in range(s)]))
+    return obs, N
+
+
+def test_wahba_and_badshah_recover_a_rotation_exactly():
+    R = attitude_from_euler(np.radians([5.0, -3.0]), np.radians([10.0, 2.0]), np.radians([30.0, 250.0]))
+    b = R.as_matrix() @ F
+    assert np.allclose(wahba_svd(b, F), R.as_matrix(), atol=1e-12)
+    assert np.allclose(badshah_eq10(b, F), R.as_matrix(), atol=1e-12)
+
+
+def test_single_baseline_heading_and_pitch_closed_form():
+    pitch, heading = np.radians([7.0, -12.0]), np.radians([40.0, 300.0])
+    R = attitude_from_euler(pitch, np.radians([25.0, -30.0]), heading).as_matrix()  # roll does not move y
+    f = np.array([0.0, 2.0, 0.0])
+    p, h, cov = single_baseline(R @ f, np.repeat(np.eye(3)[None] * 1e-6, 2, 0), f)
+    assert np.allclose(p, pitch, atol=1e-12) and np.allclose(h, heading, atol=1e-12)
+    # isotropic 1 mm on a 2 m baseline: heading sd = 1 mm / horizontal length, pitch sd = 1 mm / length
+    assert np.allclose(np.sqrt(cov[:, 0, 0]), 1e-3 / 2.0, rtol=1e-9)
+    assert np.allclose(np.sqrt(cov[:, 1, 1]), 1e-3 / (2.0 * np.cos(pitch)), rtol=1e-9)
+
+
+def test_attitude_covariances_match_monte_carlo():
+    rng = np.random.default_rng(1)
+    R = attitude_from_euler(0.05, -0.1, 1.0).as_matrix()
+    A = rng.standard_normal((6, 6))
+    Qb = (A @ A.T + 6 * np.eye(6)) * 1e-6  # correlated mm-level baseline errors
+    n = 4000
+    e = rng.standard_normal((n, 6)) @ np.linalg.cholesky(Qb).T
+    b = (R @ F)[None] + e.reshape(n, 2, 3).transpose(0, 2, 1)
+    Qs = np.broadcast_to(Qb, (n, 6, 6))
+    w = np.ones((n, 2))
+    for est, P in ((lambda x: wahba_wls(x, F, Qs[: len(x)]), phi_covariance(R[None], F, Qb[None])[0]),
+                   (lambda x: wahba_svd(x, F, w[: len(x)]),
+                    propagated_covariance(lambda x: wahba_svd(x, F, w[:1]), (R @ F)[None], Qb[None])[0]),
+                   (lambda x: badshah_eq10(x, F),
+                    propagated_covariance(lambda x: badshah_eq10(x, F), (R @ F)[None], Qb[None])[0])):
+        phi = Rotation.from_matrix(est(b) @ R.T).as_rotvec()
+        emp = np.cov(phi.T)
+        assert np.allclose(np.sqrt(np.diag(emp)), np.sqrt(np.diag(P)), rtol=0.06)
+
+
+def test_atdop_equals_wang_eq22_gramian():
+    """Wang 2018 eq 22: three antennas, b1 = l1 forward, b2 = l2 right, body aligned with ENU."""
+    rng = np.random.default_rng(2)
+    l1, l2 = 3.965, 9.445
+    Fw = np.array([[0.0, l2], [l1, 0.0], [0.0, 0.0]])
+    s = rng.standard_normal((6, 3))  # DD line-of-sight rows s^i (any)
+    sx, sy, sz = s.T
+    L = np.array([[l1 ** 2 * (sz ** 2).sum(), 0, -l1 ** 2 * (sz * sx).sum()],
+                  [0, l2 ** 2 * (sz ** 2).sum(), -l2 ** 2 * (sz * sy).sum()],
+                  [-l1 ** 2 * (sz * sx).sum(), -l2 ** 2 * (sz * sy).sum(),
+                   l1 ** 2 * (sx ** 2).sum() + l2 ** 2 * (sy ** 2).sum()]])
+    ours = atdop(np.eye(3)[None], Fw, s[None])[0]
+    assert np.allclose(ours, np.sqrt(np.diag(np.linalg.inv(L))), rtol=1e-6)
+
+
+def test_float_solution_is_exact_without_noise_and_its_dd_rows_match_gnss_differencing():
+    rng = np.random.default_rng(3)
+    R = attitude_from_euler(0.02, 0.03, 2.0).as_matrix()
+    obs, N = _obs(rng, R, m=5, sig_phi=0.0, sig_p=0.0)
+    obs = Observations(obs.carrier, obs.code, obs.var_carrier + 1e-6, obs.var_code + 1e-2, obs.wavelength,
+                       obs.los, obs.elevation, obs.sat_ids)
+    (grp,) = float_solution(obs)
+    ref = differencing.reference_satellites(obs.elevation, np.ones(obs.elevation.shape, bool), obs.sat_ids)
+    D, ant, sat = differencing.dd_operator(ref[0], np.ones(8, bool), 3)
+    truth = N.reshape(5, -1) @ D.T
+    order = np.lexsort((sat, ant))
+    assert np.array_equal(np.round(grp.a_hat), truth[:, order])
+    assert np.allclose(grp.a_hat, truth[:, order], atol=1e-6)
+    assert np.allclose(grp.b_hat.reshape(5, 2, 3), np.broadcast_to((R @ F).T, (5, 2, 3)), atol=1e-6)
+    # Qphi = D diag(sigma^2) D' of the independent construction in simkit.gnss.differencing
+    Q, _, _ = differencing.dd_covariance(np.full((3, 8), 1e-3), ref[0], np.ones(8, bool))
+    assert np.allclose(grp.Qphi[0], Q[np.ix_(order, order)], rtol=1e-12)
+
+
+@pytest.mark.parametrize("method", ["lambda", "clambda", "mclambda"])
+def test_resolve_fixes_the_true_integers(method):
+    rng = np.random.default_rng(4)
+    R = attitude_from_euler(0.01, -0.02, 0.7).as_matrix()
+    obs, N = _obs(rng, R, m=20)
+    (grp,) = float_solution(obs)
+    res = resolve(grp, method, F)
+    ref = differencing.reference_satellites(obs.elevation, np.ones(obs.elevation.shape, bool), obs.sat_ids)
+    D, ant, sat = differencing.dd_operator(ref[0], np.ones(8, bool), 3)
+    truth = (N.reshape(20, -1) @ D.T)[:, np.lexsort((sat, ant))]
+    ok = res.accepted
+    assert ok.mean() > 0.9 and np.array_equal(res.z[ok], truth[ok])
+    assert np.all(res.success_rate > 0.99)
+    if method == "mclambda":
+        assert np.allclose(res.rotation[ok], R, atol=0.03)  # DD carrier 4 mm on 1.2-1.5 m baselines
+
+
+def test_ratio_stop_keeps_the_best_and_bounds_the_second():
+    rng = np.random.default_rng(5)
+    obs, _ = _obs(rng, attitude_from_euler(0.0, 0.0, 1.0).as_matrix(), m=6, s=6)
+    (g,) = float_solution(obs)
+    sl = slice(0, g.a_hat.shape[1] // 2)
+    args = (g.a_hat[:, sl], g.Qa[:, sl, sl], g.b_hat[:, :3], g.Qb[:, :3, :3], g.Qba[:, :3, sl], 1.5)
+    full = amb.baseline_constrained_ils(*args, n_cands=2)
+    bnd = amb.baseline_constrained_ils(*args, n_cands=2, ratio_stop=3.0)
+    assert np.array_equal(full.candidates[:, 0], bnd.candidates[:, 0])
+    assert np.allclose(full.costs[:, 0], bnd.costs[:, 0])
+    assert np.all(bnd.costs[:, 1] <= full.costs[:, 1] * (1 + 1e-12))
+    assert np.all(bnd.costs[bnd.bounded, 1] >= 3.0 * bnd.costs[bnd.bounded, 0])
+    assert set(bnd.status) <= {"bounded", "finished"}
+
+
+def test_tdcp_recovers_velocity_and_rejects_a_slip():
+    rng = np.random.default_rng(6)
+    m, s = 11, 9
+    sat0 = rng.standard_normal((s, 3))
+    sat0 = 2.6e7 * sat0 / np.linalg.norm(sat0, axis=1, keepdims=True)
+    sat0[:, 2] = np.abs(sat0[:, 2]) + 1e7  # all above a receiver near the north pole region
+    t = np.arange(m, dtype=float)
+    sat = sat0[None] + t[:, None, None] * rng.uniform(-3e3, 3e3, (1, s, 3))
+    v = np.array([20.0, -5.0, 1.0])
+    rec = np.array([1.0e6, 0.5e6, 6.2e6])[None] + t[:, None] * v
+    from simkit.attitude.geometry import sagnac_rotate
+    rho = np.linalg.norm(sagnac_rotate(sat, rec) - rec[:, None], axis=-1)
+    phase = rho + 300.0 * t[:, None] + rng.integers(-99, 99, s) * LAM
+    phase[6:, 3] += 7 * LAM  # a slip without an LLI flag
+    usable = np.ones((m - 1, s), bool)
+    vel, drift, used, rms = tdcp_velocity(phase, usable, sat, np.zeros((m, s)), rec, np.ones(m - 1))
+    assert np.allclose(vel, v, atol=1e-6) and np.allclose(drift, 300.0, atol=1e-6)
+    assert not used[5, 3] and used[[4, 6], 3].all()
+    # a 5 m error in the approximate position costs |d e| x 5 m: below 1 mm/s for these satellite motions
+    vel, *_ = tdcp_velocity(phase, usable, sat, np.zeros((m, s)), rec + 5.0 / np.sqrt(3), np.ones(m - 1))
+    assert np.abs(vel - v).max() < 1e-3
+
+
+def test_bad_input_names_the_argument():
+    rng = np.random.default_rng(7)
+    obs, _ = _obs(rng, np.eye(3), m=2)
+    with pytest.raises(AttitudeInputError, match="code"):
+        Observations(obs.carrier, obs.code[:, :1], obs.var_carrier, obs.var_code, obs.wavelength, obs.los,
+                     obs.elevation, obs.sat_ids)
+    (grp,) = float_solution(obs)
+    with pytest.raises(AttitudeInputError, match="method"):
+        resolve(grp, "ils", F)
+    with pytest.raises(differencing.DifferencingInputError, match=r"expected \(M, A, S\)"):
+        differencing.double_difference(np.zeros((3, 4)), np.zeros((3, 4), int))
+
+
+def test_euler_round_trip_used_by_the_solution():
+    e = np.radians([[3.0, -4.0, 350.0]])
+    assert np.allclose(euler_from_attitude(attitude_from_euler(*e.T)), e)
+
+
+def test_partial_fixing_fixes_true_integer_combinations_and_shrinks_the_baseline_covariance():
+    rng = np.random.default_rng(8)
+    obs, N = _obs(rng, attitude_from_euler(0.0, 0.0, 0.4).as_matrix(), m=30, s=6, sig_phi=0.003, sig_p=0.2)
+    (grp,) = float_solution(obs)
+    res = resolve(grp, "lambda", F, ratio_threshold=1e9, partial_p0=0.99)  # no full fix passes
+    ref = differencing.reference_satellites(obs.elevation, np.ones(obs.elevation.shape, bool), obs.sat_ids)
+    D, ant, sat = differencing.dd_operator(ref[0], np.ones(6, bool), 3)
+    truth = (N.reshape(30, -1) @ D.T)[:, np.lexsort((sat, ant))]
+    part = np.flatnonzero(res.partial)
+    assert part.size > 5 and not res.accepted.any()
+    right = [np.array_equal(res.Z[i].T @ truth[i], res.z_check[i]) for i in part]
+    assert np.mean(right) >= 0.9  # each subset was chosen with bootstrapped success rate >= 0.99
+    for i in part:
+        assert np.trace(res.Qb[i]) < np.trace(grp.Qb[i])
