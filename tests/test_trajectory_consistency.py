@@ -41,7 +41,8 @@ def test_high_dynamic_at_1khz_over_120s():
     assert att_err < 1.0
 
 
-@pytest.mark.parametrize("name", bundled_names())
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n == "xian_static_bds" else n
+                                  for n in bundled_names()])   # 24 h at 10 Hz: 10 s and 0.3 GB
 def test_every_bundled_scenario_at_its_own_rate(name):
     sc, truth = _truth(name)
     pos_err, vel_err, att_err = _strapdown_errors(truth, sc.trajectory.rate_hz)
