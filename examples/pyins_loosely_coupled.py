@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -163,18 +163,12 @@ def main(argv=None) -> int:
     res = referee.run(flt, args.file, duration_s=args.duration, progress=True)
     if args.csv:
         write_native_csv(args.csv, *flt.native)
-    sys.stdout.write(referee.to_markdown(res.score, "pyins run_feedback_filter (loosely coupled)", args.file))
-    print("timing: " + ", ".join(f"{k} {v:.4g}" for k, v in res.timing.items()))
-    if args.json:
-        with open(args.json, "w") as f:
-            f.write(json.dumps({"score": json.loads(referee.to_json(res.score)), "timing": res.timing}, indent=2))
+    referee.write_run_outputs(res, "pyins run_feedback_filter (loosely coupled)", args.file, args.json)
     if args.report:
-        from pathlib import Path
-
         from simkit.plots import score_figures
 
         Path(args.report).mkdir(exist_ok=True)
-        score_figures(res.score, args.report, "pyins loosely coupled")
+        score_figures(res.score, args.report, "pyins run_feedback_filter (loosely coupled)")
     return 0
 
 

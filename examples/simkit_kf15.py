@@ -17,8 +17,8 @@ first with ``simkit run airborne_stim300``), then the pyins example on the same 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -78,18 +78,12 @@ def main(argv=None) -> int:
     p.add_argument("--report", help="directory for the Markdown report and error plots")
     args = p.parse_args(argv)
     res = referee.run(SimkitKf15(), args.file, duration_s=args.duration, progress=True)
-    sys.stdout.write(referee.to_markdown(res.score, "simkit KalmanFilter15 (loosely coupled)", args.file))
-    print("timing: " + ", ".join(f"{k} {v:.4g}" for k, v in res.timing.items()))
-    if args.json:
-        with open(args.json, "w") as f:
-            f.write(json.dumps({"score": json.loads(referee.to_json(res.score)), "timing": res.timing}, indent=2))
+    referee.write_run_outputs(res, "simkit KalmanFilter15 (loosely coupled)", args.file, args.json)
     if args.report:
-        from pathlib import Path
-
         from simkit.plots import score_figures
 
         Path(args.report).mkdir(exist_ok=True)
-        score_figures(res.score, args.report, "simkit KF15 loosely coupled")
+        score_figures(res.score, args.report, "simkit KalmanFilter15 (loosely coupled)")
     return 0
 
 

@@ -1,6 +1,5 @@
 """The published LAMBDA test vectors (../shared/lambda_testvectors.json) reproduced by simkit.ambiguity."""
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -1,13 +1,10 @@
-"""Velocities, light time / Sagnac, elevation-azimuth and DOPs against RTKLIB and gnss-lib-py."""
-from pathlib import Path
+"""Velocities, light time / Sagnac, elevation-azimuth and DOPs against RTKLIB and central differences."""
 
 import numpy as np
-import pytest
 
 from simkit import frames
-from simkit.constellation import dops, kepler, load, receiver_view, visible_count
+from simkit.constellation import dops, load, receiver_view, visible_count
 
-from conftest import DATA as SHARED
 XIAN = frames.lla_to_ecef(np.radians(34.25), np.radians(108.95), 400.0)
 
 

@@ -1,6 +1,5 @@
 """Sources other than RINEX 3 broadcast: RINEX 4, almanacs (YUMA/SEM, derived), TLEs, nominal slots."""
 import gzip
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -1,6 +1,5 @@
 """GNSS error models against authorities: RTKLIB (ionmodel, tropmodel, frequencies), allantools, closed forms."""
 import numpy as np
-import pytest
 
 from simkit.gnss import atmosphere, clock, dd_covariance, noise, signals
 

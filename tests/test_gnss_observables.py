@@ -1,5 +1,4 @@
 """GNSS observables: closure on the truth terms, DD noise statistics, Doppler vs carrier, slips, blocks."""
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,7 +8,7 @@ from simkit.earth import C_LIGHT
 from simkit.constellation import load_sky
 from simkit.errors import ScenarioError
 from simkit.gnss import (GnssSimulator, dd_covariance, double_difference, parse_config, reference_satellites)
-from simkit.pipeline import gnss_rows, gnss_static_rows
+from simkit.pipeline import gnss_rows
 from simkit.section import Section
 
 from conftest import DATA

@@ -1,7 +1,6 @@
 """The file's one owner (simkit/io/schema.py), signals and stale temporaries, both deflate paths, and the
 architecture rules: acyclic imports, h5py only in simkit/io."""
 import ast
-import importlib
 import signal
 import subprocess
 import sys

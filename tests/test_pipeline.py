@@ -1,5 +1,4 @@
 """End to end: scenario -> HDF5 file; determinism, atomic writes, clear errors with exit code 2."""
-import os
 import subprocess
 import sys
 

@@ -1,7 +1,6 @@
 """``simkit validate``: scenario and file inputs agree, JSON and report outputs, exit codes, one-line errors."""
 import json
 
-import numpy as np
 import pytest
 
 import simkit

@@ -91,3 +91,16 @@ def to_markdown(sc: Score, label: str = "", truth: str = "") -> str:
     verdict = ("PASS" if sc.passed else "FAIL") if sc.checks else "no checks (no spec given)"
     out += ["", f"**Verdict: {verdict}**"]
     return "\n".join(out) + "\n"
+
+
+def write_run_outputs(res, title: str, path, json_path=None, out=None) -> None:
+    """Print a plugin run's Markdown score and timing (to ``out``, default stdout); optionally write the score and
+    timing as JSON to ``json_path``. (Figures: :func:`simkit.plots.score_figures`.)"""
+    import sys
+
+    out = out or sys.stdout
+    out.write(to_markdown(res.score, title, str(path)))
+    out.write("timing: " + ", ".join(f"{k} {v:.4g}" for k, v in res.timing.items()) + "\n")
+    if json_path:
+        with open(json_path, "w") as f:
+            f.write(json.dumps({"score": json.loads(to_json(res.score)), "timing": res.timing}, indent=2))
