@@ -20,7 +20,7 @@ from ..solution import Solution
 from . import loop, model
 from .errors import EstimatorInputError
 from .increments import from_increments, from_rates
-from .inputs import AttitudeFixes, GnssFixes, ImuData, InitialState
+from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData, InitialState
 
 STATE_NAMES = ("phi_e", "phi_n", "phi_u", "dv_e", "dv_n", "dv_u", "d_lat", "d_lon", "d_h",
                "gyro_bias_x", "gyro_bias_y", "gyro_bias_z", "accel_bias_x", "accel_bias_y", "accel_bias_z",
@@ -108,22 +108,41 @@ def _att_arrays(att: AttitudeFixes | None, t_imu):
     return (k[good].astype(np.int64), att.euler[good], att.cov[good])
 
 
+def _dd_arrays(dd: DDCarrier | None, t_imu):
+    """The loop's DD tuple (epochs at an IMU sample, one per sample, first kept), row and covariance offsets."""
+    if dd is None:
+        return (np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
+                np.zeros(1, np.int64), np.zeros(0))
+    k = sample_index(t_imu, dd.t)
+    good = (k > 0) & np.concatenate([[True], np.diff(k) > 0])
+    idx = np.flatnonzero(good)
+    m = np.diff(dd.offsets)
+    rows = np.concatenate([np.arange(dd.offsets[i], dd.offsets[i + 1]) for i in idx]) if idx.size else []
+    roff_all = np.concatenate([[0], np.cumsum(m**2)])
+    crow = np.concatenate([np.arange(roff_all[i], roff_all[i + 1]) for i in idx]) if idx.size else []
+    rows, crow = np.asarray(rows, np.int64), np.asarray(crow, np.int64)
+    return (k[idx].astype(np.int64), np.concatenate([[0], np.cumsum(m[idx])]).astype(np.int64), dd.los_enu[rows],
+            dd.baseline_b[rows], dd.range_m[rows], np.concatenate([[0], np.cumsum(m[idx] ** 2)]).astype(np.int64),
+            dd.cov[crow])
+
+
 class _LooselyCoupled:
     """Shared machinery; subclasses fix the state count and the update (Kalman or H-infinity)."""
 
     n_states = 15
     mode = 0
     name = "kf15"
+    uses_dd = False
 
     def __init__(self, config: FilterConfig | None = None, init: InitialState | None = None):
         self.config = config or FilterConfig()
         self.init = init
 
     def run(self, imu: ImuData, gnss: GnssFixes, attitude: AttitudeFixes | None = None,
-            init: InitialState | None = None) -> Solution:
-        """Filter ``imu`` with ``gnss`` fixes (and ``attitude`` fixes, used by the 21-state filter). ``init``
-        (or the constructor's) is the navigation state at ``init.t``, an IMU sample time: earlier samples are
-        not used."""
+            init: InitialState | None = None, dd: DDCarrier | None = None) -> Solution:
+        """Filter ``imu`` with ``gnss`` fixes (and ``attitude`` fixes, used by the 21-state filter, and the fixed
+        DD carrier ``dd``, used by ``kf15_dd``). ``init`` (or the constructor's) is the navigation state at
+        ``init.t``, an IMU sample time: earlier samples are not used."""
         init = init or self.init
         if init is None:
             raise EstimatorInputError(f"{self.name}.run: an InitialState is needed (see simkit.estimators.align)")
@@ -139,11 +158,13 @@ class _LooselyCoupled:
                 np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy())
         idx, garr = _gnss_arrays(gnss, imu.t)
         aarr = _att_arrays(attitude if n > 15 else None, imu.t)
+        darr = _dd_arrays(dd if self.uses_dd else None, imu.t)
         out = loop.allocate(idx.size, n)
-        att_nis = np.full(aarr[0].size, np.nan)
+        att_nis, dd_nis = np.full(aarr[0].size, np.nan), np.full(darr[0].size, np.nan)
         loop.run(phi, dvb, dt, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), garr, aarr,
-                 self._mode(), float(cfg.alpha), out, att_nis)
-        return self._solution(imu.t[garr[0]], out, att_nis)
+                 darr, self._mode(), float(cfg.alpha), out, att_nis, dd_nis)
+        sol = self._solution(imu.t[garr[0]], out, att_nis)
+        return _with_dd(sol, garr[0], darr, dd_nis) if self.uses_dd else sol
 
     def _mode(self) -> int:
         if self.mode == 0:
@@ -191,3 +212,29 @@ class HInfinityFilter(_LooselyCoupled):
 
     mode = 1
     name = "hinf"
+
+
+class KalmanFilter15DD(_LooselyCoupled):
+    """``kf15_dd``: the 15-state Kalman filter plus the fixed DD carrier of each baseline as a measurement of the
+    attitude error (tightly coupled attitude, Wang 2018 eq 16), ``run(imu, gnss, dd=DDCarrier(...))``."""
+
+    name = "kf15_dd"
+    uses_dd = True
+
+
+def _with_dd(sol: Solution, g_k, darr, dd_nis) -> Solution:
+    """Extras ``dd_rows`` (DD rows used at each output epoch's IMU sample, 0 where none) and ``dd_nis`` (NaN
+    where none); config ``dd_epochs``, ``dd_nis_mean`` and ``dd_rows_mean``."""
+    dk, m = darr[0], np.diff(darr[1])
+    rows, nis = np.zeros(g_k.size, np.int32), np.full(g_k.size, np.nan)
+    if dk.size:
+        j = np.minimum(np.searchsorted(dk, g_k), dk.size - 1)
+        hit = dk[j] == g_k
+        rows[hit], nis[hit] = m[j[hit]], dd_nis[j[hit]]
+    extras = {**sol.extras, "dd_rows": rows, "dd_nis": nis}
+    units = {**sol.extra_units, "dd_rows": "1 (fixed DD carrier rows in the update at this epoch)",
+             "dd_nis": "1 (NIS of the DD carrier update at this epoch, chi-square with dd_rows dof)"}
+    config = {**sol.config, "dd_epochs": int(darr[0].size),
+              "dd_nis_mean": float(np.nanmean(dd_nis)) if dd_nis.size else None,
+              "dd_rows_mean": float(m.mean()) if m.size else 0.0}
+    return Solution(**{**sol.__dict__, "extras": extras, "extra_units": units, "config": config})
