@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+from scipy.stats import chi2
 
 from ..frames import ecef_to_lla, euler_from_attitude, lla_to_ecef
 from ..solution import Solution
@@ -35,7 +36,8 @@ class FilterConfig:
     ``p0_gyro_bias`` rad/s, ``p0_accel_bias`` m/s^2, ``p0_lever`` m (21 states); ``cov_dt`` s covariance step;
     ``alpha`` H-infinity tuning (Wu 2015: 10); ``gamma_rule``
     "wu" (Wu's H^T H, with the weighted rule as fallback) or "weighted" (H^T R^-1 H);
-    ``gyro_bias0``/``accel_bias0`` initial bias estimates (body)."""
+    ``gyro_bias0``/``accel_bias0`` initial bias estimates (body); ``dd_gate_p`` (kf15_dd) rejects a DD carrier
+    epoch whose NIS exceeds the chi-square(m rows) quantile 1 - dd_gate_p (0: no gate)."""
 
     gyro_arw: float = 1e-4
     accel_vrw: float = 1e-3
@@ -52,6 +54,7 @@ class FilterConfig:
     gyro_bias0: tuple = (0.0, 0.0, 0.0)
     accel_bias0: tuple = (0.0, 0.0, 0.0)
     gamma_rule: str = "wu"
+    dd_gate_p: float = 0.0
 
 
 def _p0(cfg: FilterConfig, n: int, lat: float, h: float) -> np.ndarray:
@@ -108,11 +111,11 @@ def _att_arrays(att: AttitudeFixes | None, t_imu):
     return (k[good].astype(np.int64), att.euler[good], att.cov[good])
 
 
-def _dd_arrays(dd: DDCarrier | None, t_imu):
+def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0):
     """The loop's DD tuple (epochs at an IMU sample, one per sample, first kept), row and covariance offsets."""
     if dd is None:
         return (np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
-                np.zeros(1, np.int64), np.zeros(0))
+                np.zeros(1, np.int64), np.zeros(0), np.zeros(0))
     k = sample_index(t_imu, dd.t)
     good = (k > 0) & np.concatenate([[True], np.diff(k) > 0])
     idx = np.flatnonzero(good)
@@ -121,9 +124,10 @@ def _dd_arrays(dd: DDCarrier | None, t_imu):
     roff_all = np.concatenate([[0], np.cumsum(m**2)])
     crow = np.concatenate([np.arange(roff_all[i], roff_all[i + 1]) for i in idx]) if idx.size else []
     rows, crow = np.asarray(rows, np.int64), np.asarray(crow, np.int64)
+    gate = chi2.isf(gate_p, m[idx]) if gate_p > 0 else np.full(idx.size, np.inf)
     return (k[idx].astype(np.int64), np.concatenate([[0], np.cumsum(m[idx])]).astype(np.int64), dd.los_enu[rows],
             dd.baseline_b[rows], dd.range_m[rows], np.concatenate([[0], np.cumsum(m[idx] ** 2)]).astype(np.int64),
-            dd.cov[crow])
+            dd.cov[crow], np.asarray(gate, float))
 
 
 class _LooselyCoupled:
@@ -158,7 +162,7 @@ class _LooselyCoupled:
                 np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy())
         idx, garr = _gnss_arrays(gnss, imu.t)
         aarr = _att_arrays(attitude if n > 15 else None, imu.t)
-        darr = _dd_arrays(dd if self.uses_dd else None, imu.t)
+        darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p))
         out = loop.allocate(idx.size, n)
         att_nis, dd_nis = np.full(aarr[0].size, np.nan), np.full(darr[0].size, np.nan)
         loop.run(phi, dvb, dt, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), garr, aarr,
@@ -224,17 +228,18 @@ class KalmanFilter15DD(_LooselyCoupled):
 
 def _with_dd(sol: Solution, g_k, darr, dd_nis) -> Solution:
     """Extras ``dd_rows`` (DD rows used at each output epoch's IMU sample, 0 where none) and ``dd_nis`` (NaN
-    where none); config ``dd_epochs``, ``dd_nis_mean`` and ``dd_rows_mean``."""
+    where none); config ``dd_epochs``, ``dd_rejected`` (by the gate), ``dd_nis_mean`` and ``dd_rows_mean``."""
     dk, m = darr[0], np.diff(darr[1])
     rows, nis = np.zeros(g_k.size, np.int32), np.full(g_k.size, np.nan)
     if dk.size:
         j = np.minimum(np.searchsorted(dk, g_k), dk.size - 1)
         hit = dk[j] == g_k
-        rows[hit], nis[hit] = m[j[hit]], dd_nis[j[hit]]
+        jj = j[hit]
+        rows[hit], nis[hit] = np.where(dd_nis[jj] <= darr[7][jj], m[jj], 0), dd_nis[jj]
     extras = {**sol.extras, "dd_rows": rows, "dd_nis": nis}
-    units = {**sol.extra_units, "dd_rows": "1 (fixed DD carrier rows in the update at this epoch)",
+    units = {**sol.extra_units, "dd_rows": "1 (fixed DD carrier rows in the update at this epoch; 0: none or gated out)",
              "dd_nis": "1 (NIS of the DD carrier update at this epoch, chi-square with dd_rows dof)"}
-    config = {**sol.config, "dd_epochs": int(darr[0].size),
+    config = {**sol.config, "dd_epochs": int(darr[0].size), "dd_rejected": int(np.sum(dd_nis > darr[7])),
               "dd_nis_mean": float(np.nanmean(dd_nis)) if dd_nis.size else None,
               "dd_rows_mean": float(m.mean()) if m.size else 0.0}
     return Solution(**{**sol.__dict__, "extras": extras, "extra_units": units, "config": config})

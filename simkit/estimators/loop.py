@@ -51,7 +51,7 @@ def _att_update(p, c, z, r, mode, alpha):
 @njit(cache=True)
 def _dd_update(p, c, dd, i, mode, alpha):
     """Update with the fixed DD carrier rows of DD epoch ``i`` (see :func:`model.dd_rows`), INS minus GNSS."""
-    _, off, los, base, z, roff, cov = dd
+    off, los, base, z, roff, cov = dd[1], dd[2], dd[3], dd[4], dd[5], dd[6]
     a, b = off[i], off[i + 1]
     m = b - a
     pred, h = model.dd_rows(c, los[a:b], base[a:b], p.shape[0])
@@ -79,7 +79,7 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_
     """The whole recursion. ``nav0`` = (C, v, pos, bg, ba, lever); ``gnss`` = (k (M,) sample index, z (M, 6)
     [L, lambda, h, vE, vN, vU], R (M, 6, 6)); ``att`` = (k (K,), z (K, 3), R (K, 3, 3)); ``dd`` = (k (D,),
     row offsets (D + 1,), G (T, 3), body baselines (T, 3) m, ranges (T,) m, covariance offsets (D + 1,),
-    flattened covariance blocks m^2). Fills ``out``, ``att_nis`` (K,) and ``dd_nis`` (D,)."""
+    flattened covariance blocks m^2, NIS gate (D,)). Fills ``out``, ``att_nis`` (K,) and ``dd_nis`` (D,)."""
     c, v, pos, bg, ba, lever = nav0
     gk, gz, gr = gnss
     ak, az, ar = att
@@ -110,8 +110,10 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_
             ia += 1
         if d_due:
             res = _dd_update(p, c, dd, idd, mode, alpha)
-            p, dd_nis[idd] = res[1], res[2]
-            c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
+            dd_nis[idd] = res[2]
+            if res[2] <= dd[7][idd]:  # innovation gate (inf: off); a rejected epoch leaves the state alone
+                p = res[1]
+                c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
             idd += 1
         if g_due:
             res = _pv_update(p, c, v, pos, lever, ph / dt[k], gz[ig], gr[ig], mode, alpha)

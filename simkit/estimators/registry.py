@@ -32,9 +32,10 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
                      "lever_arm_error_m": [0.0, 0.0, 0.0], "attitude_source": "auto", "attitude_method": "attitude"},
             # the fixed DD carrier: ambiguity method, signals, elevation mask and ratio threshold of simkit.attitude
             "kf15_dd": {**COMMON, **FILTER, "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
-                        "dd_ratio_threshold": 3.0}}
+                        "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6}}
 CHOICES = {"gamma_rule": ("wu", "weighted"), "dd_method": ("lambda", "clambda", "mclambda"),
-           "attitude_source": ("auto", "truth", "attitude"), "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
+           "attitude_source": ("auto", "truth", "attitude"),
+           "align": ("static", "motion", "truth", "attitude"), "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
 
 
 POSITIVE = {"sigma_code_m", "sigma_doppler_m_per_s", "truth_vel_sigma_m_per_s", "cov_dt_s", "p0_vel_m_per_s",
@@ -64,6 +65,8 @@ def _check_value(key, default, value):
         raise EstimatorInputError(f"estimator.{key}: expected a positive number, got {value!r}")
     if key in CHOICES and value not in CHOICES[key]:
         raise EstimatorInputError(f"estimator.{key}: expected one of {', '.join(CHOICES[key])}, got {value!r}")
+    if key == "dd_gate_p" and not 0 <= value < 1:
+        raise EstimatorInputError(f"estimator.dd_gate_p: expected a probability in [0, 1), got {value!r}")
     if key == "alpha" and not value > 1:
         raise EstimatorInputError(f"estimator.alpha: expected > 1 (Wu 2015 uses 10), got {value!r}")
 
@@ -182,13 +185,28 @@ def filter_config(ds, p, name) -> FilterConfig:
         p0_att=tuple(np.radians(np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3))),
         p0_vel=float(p["p0_vel_m_per_s"]), p0_pos=tuple(np.broadcast_to(np.asarray(p["p0_pos_m"], float), 3)),
         p0_lever=float(p.get("p0_lever_m", 0.5)), cov_dt=float(p["cov_dt_s"]), alpha=float(p.get("alpha", 10.0)),
-        gamma_rule=str(p.get("gamma_rule", "wu")))
+        gamma_rule=str(p.get("gamma_rule", "wu")), dd_gate_p=float(p.get("dd_gate_p", 0.0)))
+
+
+def _attitude_alignment(ds, p, gnss: GnssFixes, good):
+    """([pitch, roll, heading] rad, GNSS fix index): the first fixed epoch of the attitude solver that has a
+    GNSS fix at the same time."""
+    if ds["gnss/antennas/lever_arm_b"].shape[0] < 3:
+        raise EstimatorInputError(f"estimator.align: 'attitude' needs 3 or more antennas, {ds.path} has "
+                                  f"{ds['gnss/antennas/lever_arm_b'].shape[0]}")
+    att = _solved_attitude(ds, {"attitude_method": p.get("attitude_method", "attitude")})
+    both = np.flatnonzero(np.isin(np.round(gnss.t[good], 6), np.round(att.t, 6)))
+    if both.size == 0:
+        raise EstimatorInputError("estimator.align: 'attitude' found no epoch with fixed ambiguities and a GNSS fix")
+    g0 = good[both[0]]
+    return att.euler[np.argmin(np.abs(att.t - gnss.t[g0]))], g0
 
 
 def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
     """Initial navigation state from ``p['align']``: 'static' (levelling + gyrocompassing over the first
     align_static_s; at the first IMU sample), 'motion' (from the first GNSS fix faster than 5 m/s, at its epoch),
-    'truth' (the file's truth at the first sample, a study mode), plus ``init_heading_error_deg``."""
+    'attitude' (the multi-antenna carrier-phase attitude at its first fixed epoch, 3+ antennas; at that GNSS
+    fix), 'truth' (the file's truth at the first sample, a study mode), plus ``init_heading_error_deg``."""
     good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
     if good.size == 0:
         raise EstimatorInputError(f"{ds.path}: no GNSS fix to initialise the position from")
@@ -196,6 +214,9 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
     lla_ant = ecef_to_lla(gnss.pos_ecef[g0])
     if p["align"] == "truth":
         euler, lla, vel = ds["truth/euler"][0], ds["truth/pos_lla"][0], ds["truth/vel_enu"][0]
+    elif p["align"] == "attitude":
+        euler, g0 = _attitude_alignment(ds, p, gnss, good)
+        vel, lla = gnss.vel_enu[g0], ecef_to_lla(gnss.pos_ecef[g0])
     elif p["align"] in ("static", "motion"):
         if p["align"] == "static":
             n = max(2, int(np.searchsorted(imu.t, imu.t[0] + float(p["align_static_s"]))))
@@ -212,9 +233,10 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
             lla_ant = ecef_to_lla(gnss.pos_ecef[g0])
         lla = lla_ant  # the lever arm (metres) is left to the filter's position uncertainty
     else:
-        raise EstimatorInputError(f"estimator.align: expected 'static', 'motion' or 'truth', got {p['align']!r}")
+        raise EstimatorInputError(f"estimator.align: expected 'static', 'motion', 'truth' or 'attitude', "
+                                  f"got {p['align']!r}")
     euler = np.asarray(euler, float) + [0.0, 0.0, np.radians(float(p["init_heading_error_deg"]))]
-    t0 = float(gnss.t[g0]) if p["align"] == "motion" else float(imu.t[0])
+    t0 = float(gnss.t[g0]) if p["align"] in ("motion", "attitude") else float(imu.t[0])
     return InitialState(t0, np.asarray(lla, float), np.asarray(vel, float), quat_from_euler(*euler))
 
 
