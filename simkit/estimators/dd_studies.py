@@ -3,7 +3,8 @@
 ``python -m simkit.estimators.dd_studies compare FILE [--skip S] [--set key=value ...]``
     pitch / roll / heading RMS against the file's truth (after ``--skip`` s) of kf15, kf15_dd and kf21 with
     the attitude solver's attitude (``attitude_source = "attitude"``); ``--set`` goes to all three filters.
-``python -m simkit.estimators.dd_studies nees SCENARIO [--runs N] [--seconds S] [--skip S] [--set ...]``
+``python -m simkit.estimators.dd_studies nees SCENARIO [--runs N] [--seconds S] [--skip S] [--set ...]
+[--override scenario.key=value ...]``
     attitude NEES (3 dof, the phi block) of kf15_dd over ``N`` simulated runs (seeds 1..N) of SCENARIO against
     the two-sided 95 % chi-square bounds of an N-run average; prints the epoch-averaged mean and the fraction
     of epochs inside the bounds.
@@ -55,7 +56,7 @@ def truth_at(ds, t):
 
 
 def attitude_nees(scenario: str, runs: int = 10, seconds: float = 300.0, skip_s: float = 60.0,
-                  params: dict | None = None, workdir=None) -> dict:
+                  params: dict | None = None, workdir=None, overrides=()) -> dict:
     """Monte Carlo attitude NEES of kf15_dd (see the module docstring)."""
     from ..pipeline import run as simulate
 
@@ -63,7 +64,7 @@ def attitude_nees(scenario: str, runs: int = 10, seconds: float = 300.0, skip_s:
     with tempfile.TemporaryDirectory(dir=workdir) as d:
         for i in range(runs):
             path = simulate(scenario, out=Path(d) / f"r{i}.h5", seed=1 + i,
-                            overrides=[f"scenario.duration_s={seconds}"])
+                            overrides=[f"scenario.duration_s={seconds}", *overrides])
             with open_dataset(path) as ds:
                 sol = SOLVERS["kf15_dd"](ds, {**(params or {}), "seed": 1 + i}, False)
                 e = error_states(sol, *truth_at(ds, sol.t))
@@ -72,7 +73,7 @@ def attitude_nees(scenario: str, runs: int = 10, seconds: float = 300.0, skip_s:
     k = min(v.size for v in values)
     avg = np.mean([v[:k] for v in values], axis=0)
     lo, hi = chi2_bounds(3, runs)
-    return {"scenario": scenario, "runs": runs, "seconds": seconds, "skip_s": skip_s, "epochs": k,
+    return {"scenario": scenario, "overrides": list(overrides), "runs": runs, "seconds": seconds, "skip_s": skip_s, "epochs": k,
             "nees_mean": round(float(avg.mean()), 3), "bounds_95": [round(lo, 3), round(hi, 3)],
             "fraction_inside": round(float(np.mean((avg >= lo) & (avg <= hi))), 3), "dof": 3}
 
@@ -93,11 +94,12 @@ def main(argv=None):
     p.add_argument("--runs", type=int, default=10)
     p.add_argument("--seconds", type=float, default=300.0)
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="estimator parameter")
+    p.add_argument("--override", action="append", default=[], metavar="KEY=VALUE", help="scenario override (nees)")
     a = p.parse_args(argv)
     if a.study == "compare":
         res = compare(a.target, a.skip, _params(a.set))
     else:
-        res = attitude_nees(a.target, a.runs, a.seconds, a.skip, _params(a.set))
+        res = attitude_nees(a.target, a.runs, a.seconds, a.skip, _params(a.set), overrides=a.override)
     print(json.dumps(res, indent=1))
 
 

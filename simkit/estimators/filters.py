@@ -237,7 +237,8 @@ def _with_dd(sol: Solution, g_k, darr, dd_nis) -> Solution:
         jj = j[hit]
         rows[hit], nis[hit] = np.where(dd_nis[jj] <= darr[7][jj], m[jj], 0), dd_nis[jj]
     extras = {**sol.extras, "dd_rows": rows, "dd_nis": nis}
-    units = {**sol.extra_units, "dd_rows": "1 (fixed DD carrier rows in the update at this epoch; 0: none or gated out)",
+    units = {**sol.extra_units,
+             "dd_rows": "1 (fixed DD carrier rows in the update at this epoch; 0: none or gated out)",
              "dd_nis": "1 (NIS of the DD carrier update at this epoch, chi-square with dd_rows dof)"}
     config = {**sol.config, "dd_epochs": int(darr[0].size), "dd_rejected": int(np.sum(dd_nis > darr[7])),
               "dd_nis_mean": float(np.nanmean(dd_nis)) if dd_nis.size else None,

@@ -35,7 +35,8 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
                         "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6}}
 CHOICES = {"gamma_rule": ("wu", "weighted"), "dd_method": ("lambda", "clambda", "mclambda"),
            "attitude_source": ("auto", "truth", "attitude"),
-           "align": ("static", "motion", "truth", "attitude"), "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
+           "align": ("static", "motion", "truth", "attitude"),
+           "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
 
 
 POSITIVE = {"sigma_code_m", "sigma_doppler_m_per_s", "truth_vel_sigma_m_per_s", "cov_dt_s", "p0_vel_m_per_s",
