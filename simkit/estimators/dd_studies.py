@@ -2,7 +2,8 @@
 
 ``python -m simkit.estimators.dd_studies compare FILE [--skip S] [--set key=value ...]``
     pitch / roll / heading RMS against the file's truth (after ``--skip`` s) of kf15, kf15_dd and kf21 with
-    the attitude solver's attitude (``attitude_source = "attitude"``); ``--set`` goes to all three filters.
+    the attitude solver's attitude (``attitude_source = "auto"``: the solver's attitude with 3+ antennas, else
+    the truth plus noise; the source is printed); ``--set`` goes to all three filters.
 ``python -m simkit.estimators.dd_studies nees SCENARIO [--runs N] [--seconds S] [--skip S] [--set ...]
 [--override scenario.key=value ...]``
     attitude NEES (3 dof, the phi block) of kf15_dd over ``N`` simulated runs (seeds 1..N) of SCENARIO against
@@ -24,7 +25,7 @@ from .consistency import chi2_bounds, error_states, nees
 from .evaluate import errors_vs_truth
 from .registry import SOLVERS
 
-RUNS = {"kf15": {}, "kf15_dd": {}, "kf21": {"attitude_source": "attitude"}}
+RUNS = {"kf15": {}, "kf15_dd": {}, "kf21": {"attitude_source": "auto"}}
 
 
 def attitude_rms(ds, sol, skip_s: float) -> dict:
@@ -43,9 +44,12 @@ def compare(path, skip_s: float = 60.0, params: dict | None = None) -> dict:
             sol = SOLVERS[name](ds, {**(params or {}), **own}, False)
             out[name] = attitude_rms(ds, sol, skip_s)
             if name == "kf15_dd":
-                out[name]["dd_epochs"] = sol.config["dd_epochs"]
-                out[name]["dd_nis_mean_per_row"] = round(float(np.nanmean(sol.extras["dd_nis"] /
-                                                                          sol.extras["dd_rows"])), 3)
+                used = sol.extras["dd_rows"] > 0
+                out[name]["dd_epochs"], out[name]["dd_rejected"] = sol.config["dd_epochs"], sol.config["dd_rejected"]
+                out[name]["dd_nis_mean_per_row"] = round(float(np.mean(sol.extras["dd_nis"][used] /
+                                                                       sol.extras["dd_rows"][used])), 3)
+            if name == "kf21":
+                out[name]["attitude_source"] = sol.config["attitude_source"]
     out["file"], out["skip_s"], out["params"] = str(path), skip_s, params or {}
     return out
 
