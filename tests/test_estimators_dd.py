@@ -157,3 +157,26 @@ def test_attitude_source_needs_three_antennas(tmp_path):
     path = simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=5"])
     assert_clean_error(["solve", str(path), "--filter", "kf21", "--set", "estimator.attitude_source=attitude",
                         "--set", "estimator.align=static", "-q"], tmp_path, expect="needs 3 or more antennas")
+
+
+def test_the_gate_keeps_a_corrupted_dd_epoch_out(xian):
+    from dataclasses import replace
+
+    from simkit.estimators import KalmanFilter15DD, registry
+
+    with simkit.open(xian) as ds:
+        p = registry.merged("kf15_dd", {"align": "attitude"})
+        imu, gnss = registry.imu_data(ds), registry.gnss_fixes(ds, p)
+        init = registry.initial_state(ds, p, imu, gnss)
+        dd = registry.dd_carrier(ds, p)
+        cfg = registry.filter_config(ds, p, "kf15_dd")
+    i = int(np.searchsorted(dd.t, 60.0))
+    bad = dd.range_m.copy()
+    bad[dd.offsets[i]:dd.offsets[i + 1]] += 0.05  # 5 cm on every row of one epoch: a wrong fix of ~0.25 cycle
+    dd_bad = replace(dd, range_m=bad)
+    at = lambda sol: np.argmin(np.abs(sol.t - dd.t[i]))  # noqa: E731
+    gated = KalmanFilter15DD(cfg, init).run(imu, gnss, dd=dd_bad)
+    assert gated.config["dd_rejected"] == 1 and gated.extras["dd_rows"][at(gated)] == 0
+    open_ = KalmanFilter15DD(replace(cfg, dd_gate_p=0.0), init).run(imu, gnss, dd=dd_bad)
+    assert open_.config["dd_rejected"] == 0 and open_.extras["dd_rows"][at(open_)] > 0
+    assert open_.extras["dd_nis"][at(open_)] == gated.extras["dd_nis"][at(gated)] > 100
