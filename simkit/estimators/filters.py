@@ -111,6 +111,13 @@ def _att_arrays(att: AttitudeFixes | None, t_imu):
     return (k[good].astype(np.int64), att.euler[good], att.cov[good])
 
 
+def _spans(starts, lengths):
+    """Indices starts[i] .. starts[i] + lengths[i] - 1 of every i, concatenated (int64)."""
+    lengths = np.asarray(lengths, np.int64)
+    first = np.cumsum(lengths) - lengths
+    return (np.repeat(np.asarray(starts, np.int64) - first, lengths) + np.arange(lengths.sum())).astype(np.int64)
+
+
 def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0):
     """The loop's DD tuple (epochs at an IMU sample, one per sample, first kept), row and covariance offsets."""
     if dd is None:
@@ -120,10 +127,8 @@ def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0):
     good = (k > 0) & np.concatenate([[True], np.diff(k) > 0])
     idx = np.flatnonzero(good)
     m = np.diff(dd.offsets)
-    rows = np.concatenate([np.arange(dd.offsets[i], dd.offsets[i + 1]) for i in idx]) if idx.size else []
-    roff_all = np.concatenate([[0], np.cumsum(m**2)])
-    crow = np.concatenate([np.arange(roff_all[i], roff_all[i + 1]) for i in idx]) if idx.size else []
-    rows, crow = np.asarray(rows, np.int64), np.asarray(crow, np.int64)
+    rows = _spans(dd.offsets[idx], m[idx])
+    crow = _spans(np.concatenate([[0], np.cumsum(m**2)])[idx], m[idx] ** 2)
     gate = chi2.isf(gate_p, m[idx]) if gate_p > 0 else np.full(idx.size, np.inf)
     return (k[idx].astype(np.int64), np.concatenate([[0], np.cumsum(m[idx])]).astype(np.int64), dd.los_enu[rows],
             dd.baseline_b[rows], dd.range_m[rows], np.concatenate([[0], np.cumsum(m[idx] ** 2)]).astype(np.int64),
