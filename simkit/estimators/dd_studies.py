@@ -77,7 +77,8 @@ def attitude_nees(scenario: str, runs: int = 10, seconds: float = 300.0, skip_s:
     k = min(v.size for v in values)
     avg = np.mean([v[:k] for v in values], axis=0)
     lo, hi = chi2_bounds(3, runs)
-    return {"scenario": scenario, "overrides": list(overrides), "runs": runs, "seconds": seconds, "skip_s": skip_s, "epochs": k,
+    return {"scenario": scenario, "overrides": list(overrides), "runs": runs, "seconds": seconds, "skip_s": skip_s,
+            "epochs": k,
             "nees_mean": round(float(avg.mean()), 3), "bounds_95": [round(lo, 3), round(hi, 3)],
             "fraction_inside": round(float(np.mean((avg >= lo) & (avg <= hi))), 3), "dof": 3}
 

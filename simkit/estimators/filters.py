@@ -10,7 +10,7 @@ congruent form L^T (P^-1 - theta I + H^T R^-1 H) L, P = L L^T: dimensionless, po
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
