@@ -180,3 +180,12 @@ def test_the_gate_keeps_a_corrupted_dd_epoch_out(xian):
     open_ = KalmanFilter15DD(replace(cfg, dd_gate_p=0.0), init).run(imu, gnss, dd=dd_bad)
     assert open_.config["dd_rejected"] == 0 and open_.extras["dd_rows"][at(open_)] > 0
     assert open_.extras["dd_nis"][at(open_)] == gated.extras["dd_nis"][at(gated)] > 100
+
+
+@pytest.mark.slow
+def test_kf15_dd_attitude_nees_is_within_the_chi2_bounds_over_a_monte_carlo(tmp_path):
+    from simkit.estimators.dd_studies import attitude_nees
+
+    res = attitude_nees("airborne_stim300", runs=6, seconds=150.0, skip_s=60.0, workdir=tmp_path)
+    lo, hi = res["bounds_95"]
+    assert lo < res["nees_mean"] < hi and res["fraction_inside"] > 0.75, res
