@@ -8,10 +8,11 @@ from .dd import FloatGroup, Observations, float_solution
 from .errors import AttitudeInputError
 from .resolve import METHODS, Resolution, resolve
 from .solvers import build_registry
+from .tight import FixedDD, fixed_dd, read_fixed_dd
 from .wahba import atdop, badshah_eq10, euler_covariance, phi_covariance, single_baseline, wahba_svd
 
 SOLVERS = build_registry()
 
-__all__ = ["AttitudeInputError", "FloatGroup", "METHODS", "Observations", "Resolution", "SOLVERS", "atdop",
-           "badshah_eq10", "euler_covariance", "float_solution", "phi_covariance", "resolve", "single_baseline",
-           "wahba_svd"]
+__all__ = ["AttitudeInputError", "FixedDD", "FloatGroup", "METHODS", "Observations", "Resolution", "SOLVERS",
+           "atdop", "badshah_eq10", "euler_covariance", "fixed_dd", "float_solution", "phi_covariance",
+           "read_fixed_dd", "resolve", "single_baseline", "wahba_svd"]

@@ -5,13 +5,14 @@ attitude variant) and H-infinity filters, code/Doppler single-point positioning.
 """
 from .align import motion_alignment, static_alignment
 from .errors import EstimatorInputError
-from .filters import FilterConfig, HInfinityFilter, KalmanFilter15, KalmanFilter21, STATE_NAMES
-from .inputs import AttitudeFixes, GnssFixes, ImuData, InitialState
+from .filters import FilterConfig, HInfinityFilter, KalmanFilter15, KalmanFilter15DD, KalmanFilter21, STATE_NAMES
+from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData, InitialState
 from .kalman import Correction, kalman_update
 from .registry import DEFAULTS, SOLVERS
 from .spp import SppFixes, spp
 from .strapdown import strapdown
 
-__all__ = ["AttitudeFixes", "Correction", "DEFAULTS", "EstimatorInputError", "FilterConfig", "GnssFixes",
-           "HInfinityFilter", "ImuData", "InitialState", "KalmanFilter15", "KalmanFilter21", "SOLVERS",
+__all__ = ["AttitudeFixes", "Correction", "DDCarrier", "DEFAULTS", "EstimatorInputError", "FilterConfig",
+           "GnssFixes", "HInfinityFilter", "ImuData", "InitialState", "KalmanFilter15", "KalmanFilter15DD",
+           "KalmanFilter21", "SOLVERS",
            "STATE_NAMES", "SppFixes", "kalman_update", "motion_alignment", "spp", "static_alignment", "strapdown"]

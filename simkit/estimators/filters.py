@@ -10,17 +10,18 @@ congruent form L^T (P^-1 - theta I + H^T R^-1 H) L, P = L L^T: dimensionless, po
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+from scipy.stats import chi2
 
 from ..frames import ecef_to_lla, euler_from_attitude, lla_to_ecef
 from ..solution import Solution
 from . import loop, model
 from .errors import EstimatorInputError
 from .increments import from_increments, from_rates
-from .inputs import AttitudeFixes, GnssFixes, ImuData, InitialState
+from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData, InitialState
 
 STATE_NAMES = ("phi_e", "phi_n", "phi_u", "dv_e", "dv_n", "dv_u", "d_lat", "d_lon", "d_h",
                "gyro_bias_x", "gyro_bias_y", "gyro_bias_z", "accel_bias_x", "accel_bias_y", "accel_bias_z",
@@ -35,7 +36,8 @@ class FilterConfig:
     ``p0_gyro_bias`` rad/s, ``p0_accel_bias`` m/s^2, ``p0_lever`` m (21 states); ``cov_dt`` s covariance step;
     ``alpha`` H-infinity tuning (Wu 2015: 10); ``gamma_rule``
     "wu" (Wu's H^T H, with the weighted rule as fallback) or "weighted" (H^T R^-1 H);
-    ``gyro_bias0``/``accel_bias0`` initial bias estimates (body)."""
+    ``gyro_bias0``/``accel_bias0`` initial bias estimates (body); ``dd_gate_p`` (kf15_dd) rejects a DD carrier
+    epoch whose NIS exceeds the chi-square(m rows) quantile 1 - dd_gate_p (0: no gate)."""
 
     gyro_arw: float = 1e-4
     accel_vrw: float = 1e-3
@@ -52,6 +54,7 @@ class FilterConfig:
     gyro_bias0: tuple = (0.0, 0.0, 0.0)
     accel_bias0: tuple = (0.0, 0.0, 0.0)
     gamma_rule: str = "wu"
+    dd_gate_p: float = 0.0
 
 
 def _p0(cfg: FilterConfig, n: int, lat: float, h: float) -> np.ndarray:
@@ -108,22 +111,47 @@ def _att_arrays(att: AttitudeFixes | None, t_imu):
     return (k[good].astype(np.int64), att.euler[good], att.cov[good])
 
 
+def _spans(starts, lengths):
+    """Indices starts[i] .. starts[i] + lengths[i] - 1 of every i, concatenated (int64)."""
+    lengths = np.asarray(lengths, np.int64)
+    first = np.cumsum(lengths) - lengths
+    return (np.repeat(np.asarray(starts, np.int64) - first, lengths) + np.arange(lengths.sum())).astype(np.int64)
+
+
+def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0):
+    """The loop's DD tuple (epochs at an IMU sample, one per sample, first kept), row and covariance offsets."""
+    if dd is None:
+        return (np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
+                np.zeros(1, np.int64), np.zeros(0), np.zeros(0))
+    k = sample_index(t_imu, dd.t)
+    good = (k > 0) & np.concatenate([[True], np.diff(k) > 0])
+    idx = np.flatnonzero(good)
+    m = np.diff(dd.offsets)
+    rows = _spans(dd.offsets[idx], m[idx])
+    crow = _spans(np.concatenate([[0], np.cumsum(m**2)])[idx], m[idx] ** 2)
+    gate = chi2.isf(gate_p, m[idx]) if gate_p > 0 else np.full(idx.size, np.inf)
+    return (k[idx].astype(np.int64), np.concatenate([[0], np.cumsum(m[idx])]).astype(np.int64), dd.los_enu[rows],
+            dd.baseline_b[rows], dd.range_m[rows], np.concatenate([[0], np.cumsum(m[idx] ** 2)]).astype(np.int64),
+            dd.cov[crow], np.asarray(gate, float))
+
+
 class _LooselyCoupled:
     """Shared machinery; subclasses fix the state count and the update (Kalman or H-infinity)."""
 
     n_states = 15
     mode = 0
     name = "kf15"
+    uses_dd = False
 
     def __init__(self, config: FilterConfig | None = None, init: InitialState | None = None):
         self.config = config or FilterConfig()
         self.init = init
 
     def run(self, imu: ImuData, gnss: GnssFixes, attitude: AttitudeFixes | None = None,
-            init: InitialState | None = None) -> Solution:
-        """Filter ``imu`` with ``gnss`` fixes (and ``attitude`` fixes, used by the 21-state filter). ``init``
-        (or the constructor's) is the navigation state at ``init.t``, an IMU sample time: earlier samples are
-        not used."""
+            init: InitialState | None = None, dd: DDCarrier | None = None) -> Solution:
+        """Filter ``imu`` with ``gnss`` fixes (and ``attitude`` fixes, used by the 21-state filter, and the fixed
+        DD carrier ``dd``, used by ``kf15_dd``). ``init`` (or the constructor's) is the navigation state at
+        ``init.t``, an IMU sample time: earlier samples are not used."""
         init = init or self.init
         if init is None:
             raise EstimatorInputError(f"{self.name}.run: an InitialState is needed (see simkit.estimators.align)")
@@ -139,11 +167,13 @@ class _LooselyCoupled:
                 np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy())
         idx, garr = _gnss_arrays(gnss, imu.t)
         aarr = _att_arrays(attitude if n > 15 else None, imu.t)
+        darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p))
         out = loop.allocate(idx.size, n)
-        att_nis = np.full(aarr[0].size, np.nan)
+        att_nis, dd_nis = np.full(aarr[0].size, np.nan), np.full(darr[0].size, np.nan)
         loop.run(phi, dvb, dt, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), garr, aarr,
-                 self._mode(), float(cfg.alpha), out, att_nis)
-        return self._solution(imu.t[garr[0]], out, att_nis)
+                 darr, self._mode(), float(cfg.alpha), out, att_nis, dd_nis)
+        sol = self._solution(imu.t[garr[0]], out, att_nis)
+        return _with_dd(sol, garr[0], darr, dd_nis) if self.uses_dd else sol
 
     def _mode(self) -> int:
         if self.mode == 0:
@@ -191,3 +221,31 @@ class HInfinityFilter(_LooselyCoupled):
 
     mode = 1
     name = "hinf"
+
+
+class KalmanFilter15DD(_LooselyCoupled):
+    """``kf15_dd``: the 15-state Kalman filter plus the fixed DD carrier of each baseline as a measurement of the
+    attitude error (tightly coupled attitude, Wang 2018 eq 16), ``run(imu, gnss, dd=DDCarrier(...))``."""
+
+    name = "kf15_dd"
+    uses_dd = True
+
+
+def _with_dd(sol: Solution, g_k, darr, dd_nis) -> Solution:
+    """Extras ``dd_rows`` (DD rows used at each output epoch's IMU sample, 0 where none) and ``dd_nis`` (NaN
+    where none); config ``dd_epochs``, ``dd_rejected`` (by the gate), ``dd_nis_mean`` and ``dd_rows_mean``."""
+    dk, m = darr[0], np.diff(darr[1])
+    rows, nis = np.zeros(g_k.size, np.int32), np.full(g_k.size, np.nan)
+    if dk.size:
+        j = np.minimum(np.searchsorted(dk, g_k), dk.size - 1)
+        hit = dk[j] == g_k
+        jj = j[hit]
+        rows[hit], nis[hit] = np.where(dd_nis[jj] <= darr[7][jj], m[jj], 0), dd_nis[jj]
+    extras = {**sol.extras, "dd_rows": rows, "dd_nis": nis}
+    units = {**sol.extra_units,
+             "dd_rows": "1 (fixed DD carrier rows in the update at this epoch; 0: none or gated out)",
+             "dd_nis": "1 (NIS of the DD carrier update at this epoch, chi-square with dd_rows dof)"}
+    config = {**sol.config, "dd_epochs": int(darr[0].size), "dd_rejected": int(np.sum(dd_nis > darr[7])),
+              "dd_nis_mean": float(np.nanmean(dd_nis)) if dd_nis.size else None,
+              "dd_rows_mean": float(m.mean()) if m.size else 0.0}
+    return Solution(**{**sol.__dict__, "extras": extras, "extra_units": units, "config": config})

@@ -99,3 +99,37 @@ class InitialState:
     pos_lla: np.ndarray
     vel_enu: np.ndarray
     quat_nb: np.ndarray
+
+
+@dataclass(frozen=True)
+class DDCarrier:
+    """Fixed double-differenced carrier, K epochs, T rows: ``t`` (K,) s; ``offsets`` (K + 1,) int, the rows of
+    epoch i are offsets[i]:offsets[i+1]; ``los_enu`` (T, 3) DD geometry G = -(e_s - e_ref) (ENU unit lines of
+    sight receiver -> satellite); ``baseline_b`` (T, 3) m, the row's baseline (antenna k minus antenna 0) in the
+    body frame; ``range_m`` (T,) m = lambda (DD phi - N_fixed) = G . C_b^n baseline_b + noise; ``cov`` (sum of
+    m_i^2,) m^2, the m_i x m_i covariance of each epoch's rows, flattened row-major and concatenated."""
+
+    t: np.ndarray
+    offsets: np.ndarray
+    los_enu: np.ndarray
+    baseline_b: np.ndarray
+    range_m: np.ndarray
+    cov: np.ndarray
+
+    def __post_init__(self):
+        t = np.asarray(self.t, dtype=float)
+        off = np.asarray(self.offsets, dtype=np.int64)
+        if t.ndim != 1 or off.shape != (t.size + 1,) or off[0] != 0 or np.any(np.diff(off) < 1):
+            raise EstimatorInputError(f"dd.offsets: expected {t.size + 1} increasing row offsets from 0 "
+                                      f"(one or more rows per epoch), got shape {off.shape}")
+        n = int(off[-1])
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "offsets", off)
+        object.__setattr__(self, "los_enu", _rows("dd.los_enu", self.los_enu, n, 3))
+        object.__setattr__(self, "baseline_b", _rows("dd.baseline_b", self.baseline_b, n, 3))
+        object.__setattr__(self, "range_m", _rows("dd.range_m", np.reshape(self.range_m, (-1, 1)), n, 1)[:, 0])
+        cov = np.ascontiguousarray(self.cov, dtype=float)
+        if cov.shape != (int(np.sum(np.diff(off) ** 2)),):
+            raise EstimatorInputError(f"dd.cov: expected {int(np.sum(np.diff(off) ** 2))} values (the m_i x m_i "
+                                      f"blocks flattened), got shape {cov.shape}")
+        object.__setattr__(self, "cov", cov)

@@ -49,6 +49,17 @@ def _att_update(p, c, z, r, mode, alpha):
 
 
 @njit(cache=True)
+def _dd_update(p, c, dd, i, mode, alpha):
+    """Update with the fixed DD carrier rows of DD epoch ``i`` (see :func:`model.dd_rows`), INS minus GNSS."""
+    off, los, base, z, roff, cov = dd[1], dd[2], dd[3], dd[4], dd[5], dd[6]
+    a, b = off[i], off[i + 1]
+    m = b - a
+    pred, h = model.dd_rows(c, los[a:b], base[a:b], p.shape[0])
+    r = cov[roff[i]:roff[i + 1]].copy().reshape((m, m))
+    return _update(p, pred - z[a:b], h, r, mode, alpha)
+
+
+@njit(cache=True)
 def _record(out, j, c, v, pos, p, bg, ba, lever, res):
     o_c, o_v, o_p, o_cov, o_b, o_l, o_g, o_m, o_nis, o_w, o_s = out
     o_c[j], o_v[j], o_p[j], o_cov[j] = c, v, pos, p
@@ -64,15 +75,18 @@ def allocate(m, n):
 
 
 @njit(cache=True)
-def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, mode, alpha, out, att_nis):
+def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_nis, dd_nis):
     """The whole recursion. ``nav0`` = (C, v, pos, bg, ba, lever); ``gnss`` = (k (M,) sample index, z (M, 6)
-    [L, lambda, h, vE, vN, vU], R (M, 6, 6)); ``att`` = (k (K,), z (K, 3), R (K, 3, 3)). Fills ``out``."""
+    [L, lambda, h, vE, vN, vU], R (M, 6, 6)); ``att`` = (k (K,), z (K, 3), R (K, 3, 3)); ``dd`` = (k (D,),
+    row offsets (D + 1,), G (T, 3), body baselines (T, 3) m, ranges (T,) m, covariance offsets (D + 1,),
+    flattened covariance blocks m^2, NIS gate (D,)). Fills ``out``, ``att_nis`` (K,) and ``dd_nis`` (D,)."""
     c, v, pos, bg, ba, lever = nav0
     gk, gz, gr = gnss
     ak, az, ar = att
+    dk = dd[0]
     v_prev = v.copy()
     fsum, tacc = np.zeros(3), 0.0
-    ig, ia = 0, 0
+    ig, ia, idd = 0, 0, 0
     for k in range(dt.size):
         s = k + 1
         ph, dv = phi[k] - bg * dt[k], dvb[k] - ba * dt[k]
@@ -82,7 +96,8 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, mode, alpha, out, att_nis)
         tacc += dt[k]
         g_due = ig < gk.size and gk[ig] == s
         a_due = ia < ak.size and ak[ia] == s
-        if tacc >= cov_dt - 1e-9 or g_due or a_due:
+        d_due = idd < dk.size and dk[idd] == s
+        if tacc >= cov_dt - 1e-9 or g_due or a_due or d_due:
             phim, qd = model.discretise(model.system_matrix(c, v, pos, fsum / tacc, p.shape[0]), qc, tacc)
             p = phim @ p @ phim.T + qd
             fsum, tacc = np.zeros(3), 0.0
@@ -93,6 +108,13 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, mode, alpha, out, att_nis)
             p, att_nis[ia] = res[1], res[2]
             c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
             ia += 1
+        if d_due:
+            res = _dd_update(p, c, dd, idd, mode, alpha)
+            dd_nis[idd] = res[2]
+            if res[2] <= dd[7][idd]:  # innovation gate (inf: off); a rejected epoch leaves the state alone
+                p = res[1]
+                c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
+            idd += 1
         if g_due:
             res = _pv_update(p, c, v, pos, lever, ph / dt[k], gz[ig], gr[ig], mode, alpha)
             p = res[1]

@@ -146,3 +146,19 @@ def antenna_rows(c, v, pos, lever, w_ib_b, n):
         h[0:3, 15:18] = tp @ c
         h[3:6, 15:18] = c @ nav.skew(w_nb)
     return pred, h
+
+
+@njit(cache=True)
+def dd_rows(c, los, base_b, n):
+    """Predicted fixed DD carrier ranges (m,) m and H (m, n) for DD geometry rows ``los`` (m, 3) (ENU,
+    G = -(e_s - e_ref)) and body baselines ``base_b`` (m, 3) m: pred = G . C b^b. With C~ = (I - [phi x]) C,
+    d pred / d phi = G [(C b) x] = s_b^T [b x] C^T for s_b = C^T G: Wang 2018 eq 16 (body-frame DD line of
+    sight and baseline) turned into the ENU attitude error of this filter."""
+    m = los.shape[0]
+    pred = np.empty(m)
+    h = np.zeros((m, n))
+    for i in range(m):
+        bn = c @ base_b[i]
+        pred[i] = los[i] @ bn
+        h[i, 0:3] = los[i] @ nav.skew(bn)
+    return pred, h

@@ -1,4 +1,4 @@
-"""``simkit solve`` entries: ``SOLVERS[name](ds, params, progress) -> Solution`` for spp, kf15, kf21, hinf.
+"""``simkit solve`` entries: ``SOLVERS[name](ds, params, progress) -> Solution`` for spp, kf15, kf15_dd, kf21, hinf.
 
 ``params`` are ``--set estimator.key=value`` overrides over ``DEFAULTS`` (an unknown key is an error naming it).
 Noise defaults come from the file's ``/imu`` model attributes (white noise, turn-on bias, rate random walk), so
@@ -10,12 +10,13 @@ import json
 
 import numpy as np
 
+from .. import attitude as gnss_attitude
 from ..frames import ecef_to_lla, enu_to_ecef_vec, ecef_to_enu_vec, quat_from_euler
 from ..solution import Solution
 from .align import motion_alignment, static_alignment
 from .errors import EstimatorInputError
-from .filters import FilterConfig, HInfinityFilter, KalmanFilter15, KalmanFilter21
-from .inputs import AttitudeFixes, GnssFixes, ImuData, InitialState
+from .filters import FilterConfig, HInfinityFilter, KalmanFilter15, KalmanFilter15DD, KalmanFilter21
+from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData, InitialState
 from .spp import spp
 
 COMMON = {"gnss": "spp", "antenna": 0, "elevation_mask_deg": 10.0, "sigma_code_m": 3.0,
@@ -28,11 +29,18 @@ FILTER = {"align": "motion", "align_static_s": 10.0, "init_heading_error_deg": 0
 DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
             "hinf": {**COMMON, **FILTER, "alpha": 10.0, "gamma_rule": "wu"},
             "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.5,
-                     "lever_arm_error_m": [0.0, 0.0, 0.0]}}
+                     "lever_arm_error_m": [0.0, 0.0, 0.0], "attitude_source": "auto", "attitude_method": "attitude"},
+            # the fixed DD carrier: ambiguity method, signals, elevation mask and ratio threshold of simkit.attitude
+            "kf15_dd": {**COMMON, **FILTER, "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
+                        "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6}}
+CHOICES = {"gamma_rule": ("wu", "weighted"), "dd_method": ("lambda", "clambda", "mclambda"),
+           "attitude_source": ("auto", "truth", "attitude"),
+           "align": ("static", "motion", "truth", "attitude"),
+           "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
 
 
 POSITIVE = {"sigma_code_m", "sigma_doppler_m_per_s", "truth_vel_sigma_m_per_s", "cov_dt_s", "p0_vel_m_per_s",
-            "pos_sigma_scale", "attitude_sigma_deg", "align_static_s", "p0_lever_m"}
+            "pos_sigma_scale", "attitude_sigma_deg", "align_static_s", "p0_lever_m", "dd_ratio_threshold"}
 
 
 def _number(x) -> bool:
@@ -56,8 +64,10 @@ def _check_value(key, default, value):
         raise EstimatorInputError(f"estimator.{key}: expected {want}, got {value!r}")
     if key in POSITIVE and not value > 0:
         raise EstimatorInputError(f"estimator.{key}: expected a positive number, got {value!r}")
-    if key == "gamma_rule" and value not in ("wu", "weighted"):
-        raise EstimatorInputError(f"estimator.gamma_rule: expected 'wu' or 'weighted', got {value!r}")
+    if key in CHOICES and value not in CHOICES[key]:
+        raise EstimatorInputError(f"estimator.{key}: expected one of {', '.join(CHOICES[key])}, got {value!r}")
+    if key == "dd_gate_p" and not 0 <= value < 1:
+        raise EstimatorInputError(f"estimator.dd_gate_p: expected a probability in [0, 1), got {value!r}")
     if key == "alpha" and not value > 1:
         raise EstimatorInputError(f"estimator.alpha: expected > 1 (Wu 2015 uses 10), got {value!r}")
 
@@ -176,13 +186,28 @@ def filter_config(ds, p, name) -> FilterConfig:
         p0_att=tuple(np.radians(np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3))),
         p0_vel=float(p["p0_vel_m_per_s"]), p0_pos=tuple(np.broadcast_to(np.asarray(p["p0_pos_m"], float), 3)),
         p0_lever=float(p.get("p0_lever_m", 0.5)), cov_dt=float(p["cov_dt_s"]), alpha=float(p.get("alpha", 10.0)),
-        gamma_rule=str(p.get("gamma_rule", "wu")))
+        gamma_rule=str(p.get("gamma_rule", "wu")), dd_gate_p=float(p.get("dd_gate_p", 0.0)))
+
+
+def _attitude_alignment(ds, p, gnss: GnssFixes, good):
+    """([pitch, roll, heading] rad, GNSS fix index): the first fixed epoch of the attitude solver that has a
+    GNSS fix at the same time."""
+    if ds["gnss/antennas/lever_arm_b"].shape[0] < 3:
+        raise EstimatorInputError(f"estimator.align: 'attitude' needs 3 or more antennas, {ds.path} has "
+                                  f"{ds['gnss/antennas/lever_arm_b'].shape[0]}")
+    att = _solved_attitude(ds, {"attitude_method": p.get("attitude_method", "attitude")})
+    both = np.flatnonzero(np.isin(np.round(gnss.t[good], 6), np.round(att.t, 6)))
+    if both.size == 0:
+        raise EstimatorInputError("estimator.align: 'attitude' found no epoch with fixed ambiguities and a GNSS fix")
+    g0 = good[both[0]]
+    return att.euler[np.argmin(np.abs(att.t - gnss.t[g0]))], g0
 
 
 def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
     """Initial navigation state from ``p['align']``: 'static' (levelling + gyrocompassing over the first
     align_static_s; at the first IMU sample), 'motion' (from the first GNSS fix faster than 5 m/s, at its epoch),
-    'truth' (the file's truth at the first sample, a study mode), plus ``init_heading_error_deg``."""
+    'attitude' (the multi-antenna carrier-phase attitude at its first fixed epoch, 3+ antennas; at that GNSS
+    fix), 'truth' (the file's truth at the first sample, a study mode), plus ``init_heading_error_deg``."""
     good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
     if good.size == 0:
         raise EstimatorInputError(f"{ds.path}: no GNSS fix to initialise the position from")
@@ -190,6 +215,9 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
     lla_ant = ecef_to_lla(gnss.pos_ecef[g0])
     if p["align"] == "truth":
         euler, lla, vel = ds["truth/euler"][0], ds["truth/pos_lla"][0], ds["truth/vel_enu"][0]
+    elif p["align"] == "attitude":
+        euler, g0 = _attitude_alignment(ds, p, gnss, good)
+        vel, lla = gnss.vel_enu[g0], ecef_to_lla(gnss.pos_ecef[g0])
     elif p["align"] in ("static", "motion"):
         if p["align"] == "static":
             n = max(2, int(np.searchsorted(imu.t, imu.t[0] + float(p["align_static_s"]))))
@@ -206,15 +234,40 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
             lla_ant = ecef_to_lla(gnss.pos_ecef[g0])
         lla = lla_ant  # the lever arm (metres) is left to the filter's position uncertainty
     else:
-        raise EstimatorInputError(f"estimator.align: expected 'static', 'motion' or 'truth', got {p['align']!r}")
+        raise EstimatorInputError(f"estimator.align: expected 'static', 'motion', 'truth' or 'attitude', "
+                                  f"got {p['align']!r}")
     euler = np.asarray(euler, float) + [0.0, 0.0, np.radians(float(p["init_heading_error_deg"]))]
-    t0 = float(gnss.t[g0]) if p["align"] == "motion" else float(imu.t[0])
+    t0 = float(gnss.t[g0]) if p["align"] in ("motion", "attitude") else float(imu.t[0])
     return InitialState(t0, np.asarray(lla, float), np.asarray(vel, float), quat_from_euler(*euler))
 
 
+def attitude_source(ds, p) -> str:
+    """``p['attitude_source']`` with "auto" resolved: "attitude" when the file has 3 or more antennas, else
+    "truth"; "attitude" with fewer than 3 antennas is an error naming the key."""
+    n_ant = ds["gnss/antennas/lever_arm_b"].shape[0]
+    src = p["attitude_source"]
+    if src == "auto":
+        return "attitude" if n_ant >= 3 else "truth"
+    if src == "attitude" and n_ant < 3:
+        raise EstimatorInputError(f"estimator.attitude_source: 'attitude' needs 3 or more antennas (pitch, roll "
+                                  f"and heading), {ds.path} has {n_ant}; use 'truth'")
+    return src
+
+
+def _solved_attitude(ds, p) -> AttitudeFixes:
+    """GNSS attitude from the multi-antenna carrier-phase solver ``p['attitude_method']`` of simkit.attitude:
+    its Euler angles and their covariance at the epochs whose ambiguities are fixed and validated (status
+    fixed, or wrong fix: the filter cannot tell them apart)."""
+    sol = gnss_attitude.SOLVERS[p["attitude_method"]](ds, {})
+    ok = np.isin(sol.extras["status"], (1, 3)) & np.isfinite(sol.euler).all(1) & np.isfinite(sol.cov).all((1, 2))
+    return AttitudeFixes(sol.t[ok], sol.euler[ok], sol.cov[ok])
+
+
 def _attitude(ds, p) -> AttitudeFixes:
-    """GNSS attitude for the 21-state filter: for now the truth at the GNSS epochs plus white noise of
-    attitude_sigma_deg (until the multi-antenna attitude solution of Estimators II is plugged in)."""
+    """GNSS attitude for the 21-state filter: from the attitude solver (``attitude_source`` "attitude"), or the
+    truth at the GNSS epochs plus white noise of attitude_sigma_deg ("truth": a study input)."""
+    if attitude_source(ds, p) == "attitude":
+        return _solved_attitude(ds, p)
     t = ds["gnss/t"][:]
     k = np.clip(np.searchsorted(ds["truth/t"][:], t), 0, ds["truth/t"].shape[0] - 1)
     sig = np.radians(float(p["attitude_sigma_deg"]))
@@ -222,20 +275,33 @@ def _attitude(ds, p) -> AttitudeFixes:
     return AttitudeFixes(t, ds["truth/euler"][:][k] + rng.normal(size=(t.size, 3)) * sig, np.full(3, sig))
 
 
+def dd_carrier(ds, p) -> DDCarrier:
+    """The fixed DD carrier of every baseline from ``simkit.attitude`` (``dd_method``, ``dd_signals``,
+    ``dd_mask_deg``, ``dd_ratio_threshold``; the other ambiguity parameters at their defaults)."""
+    n_ant = ds["gnss/antennas/lever_arm_b"].shape[0]
+    if n_ant < 2:
+        raise EstimatorInputError(f"{ds.path}: kf15_dd needs 2 or more antennas (one baseline), the file has {n_ant}")
+    fx = gnss_attitude.read_fixed_dd(ds, {"signals": p["dd_signals"], "mask_deg": p["dd_mask_deg"],
+                                          "ratio_threshold": p["dd_ratio_threshold"]}, p["dd_method"])
+    return DDCarrier(fx.t, fx.offsets, fx.los_enu, fx.baseline_b, fx.range_m, fx.cov)
+
+
 def solve_filter(name):
-    cls = {"kf15": KalmanFilter15, "kf21": KalmanFilter21, "hinf": HInfinityFilter}[name]
+    cls = {"kf15": KalmanFilter15, "kf21": KalmanFilter21, "hinf": HInfinityFilter, "kf15_dd": KalmanFilter15DD}[name]
 
     def solve(ds, params, progress=False) -> Solution:
         p = merged(name, params)
         imu, gnss = imu_data(ds), gnss_fixes(ds, p)
         init = initial_state(ds, p, imu, gnss)
         att = _attitude(ds, p) if name == "kf21" and p["use_attitude"] else None
-        sol = cls(filter_config(ds, p, name), init).run(imu, gnss, att)
-        return Solution(**{**sol.__dict__, "config": {**sol.config, "params": p}})
+        dd = dd_carrier(ds, p) if name == "kf15_dd" else None
+        sol = cls(filter_config(ds, p, name), init).run(imu, gnss, att, dd=dd)
+        extra = {"attitude_source": attitude_source(ds, p)} if name == "kf21" and p["use_attitude"] else {}
+        return Solution(**{**sol.__dict__, "config": {**sol.config, "params": p, **extra}})
 
     solve.__doc__ = f"simkit solve --filter {name}: {cls.__doc__.splitlines()[0]}"
     return solve
 
 
-SOLVERS = {"spp": solve_spp, "kf15": solve_filter("kf15"), "kf21": solve_filter("kf21"),
-           "hinf": solve_filter("hinf")}
+SOLVERS = {"spp": solve_spp, "kf15": solve_filter("kf15"), "kf15_dd": solve_filter("kf15_dd"),
+           "kf21": solve_filter("kf21"), "hinf": solve_filter("hinf")}

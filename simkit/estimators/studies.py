@@ -51,7 +51,8 @@ def badshah(path, plot=None, heading_error_deg=10.0) -> dict:
     accuracies (position [1, 1, 5] m, velocity 0.5 cm/s, attitude 0.3 deg), with and without the attitude."""
     common = {"gnss": "truth", "truth_pos_sigma_m": [1.0, 1.0, 5.0], "truth_vel_sigma_m_per_s": 0.005,
               "align": "truth", "init_heading_error_deg": heading_error_deg,
-              "p0_att_deg": [1.0, 1.0, 1.5 * heading_error_deg], "attitude_sigma_deg": 0.3}
+              "p0_att_deg": [1.0, 1.0, 1.5 * heading_error_deg], "attitude_sigma_deg": 0.3,
+              "attitude_source": "truth"}  # Badshah's 0.3 deg attitude: the truth plus that noise
     out, curves = {}, {}
     with open_dataset(path) as ds:
         for use in (True, False):
