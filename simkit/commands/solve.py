@@ -1,6 +1,6 @@
 """``simkit solve FILE.h5 [--filter NAME ...] [--set estimator.key=value ...]``: estimators into /solutions.
 
-Filter names come from ``simkit.estimators.SOLVERS`` (spp, kf15, kf21, hinf) and, when that package exists, from
+Filter names come from ``simkit.estimators.SOLVERS`` (spp, kf15, kf15_dd, kf21, hinf) and, when that package exists, from
 ``simkit.attitude.SOLVERS``. Each writes ``/solutions/<name>`` (replacing only that group, atomically). Every
 argument is checked (file, filter names, keys, values) before any filter runs.
 """
