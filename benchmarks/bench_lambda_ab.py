@@ -1,0 +1,61 @@
+"""A/B timing of simkit.ambiguity.ils between two checkouts (e.g. before and after a change), tight enough to see
+a few per cent: each tree runs in its own interpreter, alternating, ``--rounds`` times; per problem the best of
+7 x 100 calls, then the median over 20 "well"-conditioned random problems per size.
+
+    git worktree add /tmp/before <rev>; python benchmarks/bench_lambda_ab.py /tmp/before .
+
+(bench_lambda.py gives the ratio to RTKLIB's C in the same run; its per-run noise is about +-20 %.)
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+PROBE = r"""
+import sys, time, numpy as np
+sys.path.insert(0, sys.argv[1])
+from simkit.ambiguity import ils
+from simkit.ambiguity.problems import random_problem
+try:
+    from simkit.ambiguity.warmup import wait_for_jit
+except ImportError:
+    def wait_for_jit():
+        pass
+ils(np.zeros(3), np.eye(3)); wait_for_jit()
+
+def best_us(fn, reps=100):
+    fn(); best = 1e9
+    for _ in range(7):
+        t = time.perf_counter()
+        for _ in range(reps):
+            fn()
+        best = min(best, (time.perf_counter() - t) / reps * 1e6)
+    return best
+
+row = []
+for n in (10, 20, 40):
+    rng = np.random.default_rng(n)
+    row.append(np.median([best_us(lambda: ils(a, Q, n_cands=2))
+                          for a, Q, _ in (random_problem(rng, n, "well") for _ in range(20))]))
+print(" ".join(f"{x:.1f}" for x in row))
+"""
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("a")
+    ap.add_argument("b")
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args(argv)
+    print(f"{'tree':<30} {'n=10 us':>8} {'n=20 us':>8} {'n=40 us':>8}")
+    for _ in range(args.rounds):
+        for root in (args.a, args.b):
+            out = subprocess.run([sys.executable, "-c", PROBE, root], capture_output=True, text=True, check=True)
+            print(f"{root:<30} " + " ".join(f"{v:>8}" for v in out.stdout.split()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
