@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import os
 import signal
 import sys
 
+from .commands import silence_stdout
 from .errors import SimkitError
 from .version import __version__
 
@@ -51,8 +51,7 @@ def main(argv=None) -> int:
         print(f"simkit {args.command}: interrupted{f' ({exc})' if str(exc) else ''}", file=sys.stderr)
         return 130
     except BrokenPipeError:
-        # the reader went away (| head): stop quietly; point stdout at /dev/null so the final flush cannot raise
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        silence_stdout()  # the reader went away (| head): stop quietly
         return 0
     finally:
         for sig, handler in previous.items():

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from pathlib import Path
 
+from ..atomic import atomic_open
 from ..errors import SimkitError
 from ..io import open_dataset
 
@@ -26,9 +26,9 @@ def file_digest(path) -> str:
 
 def write_json_atomic(path: Path, obj) -> None:
     """Write ``obj`` as JSON to ``path`` under a temporary name, then rename: readers never see half a file."""
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    tmp.write_text(json.dumps(obj, indent=1, allow_nan=False, default=_jsonable) + "\n", encoding="utf-8")
-    os.replace(tmp, path)
+    text = json.dumps(obj, indent=1, allow_nan=False, default=_jsonable) + "\n"
+    with atomic_open(path, "w", encoding="utf-8") as f:
+        f.write(text)
 
 
 def _jsonable(value):

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFileError, ScenarioError
+from . import silence_stdout
 
 UNITS = {"gyro": {"Q": "rad", "N": "rad/s^0.5", "B": "rad/s", "K": "rad/s^1.5", "R": "rad/s^2", "sigma": "rad/s"},
          "accel": {"Q": "m/s", "N": "m/s^1.5", "B": "m/s^2", "K": "m/s^2.5", "R": "m/s^3", "sigma": "m/s^2"}}
@@ -148,8 +149,7 @@ def _print_table(sensor, what, dt, n, preset, results):
         sys.stdout.write("\n".join(lines) + "\n")
         sys.stdout.flush()
     except BrokenPipeError:
-        devnull = os.open(os.devnull, os.O_WRONLY)   # nothing more reaches the closed pipe, not even at exit
-        os.dup2(devnull, sys.stdout.fileno())
+        silence_stdout()  # the JSON and plot asked for are still written
 
 
 def _plot(plt, out, taus, dev, results, sensor):

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import math
 import os
-import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_open
 from ..errors import ScenarioError
+from . import silence_stdout
 
 MEMORY_LIMIT_BYTES = 2 * 1024**3
 # working memory of the geometry and DOPs: tracemalloc peak 206 B per satellite-epoch (67 and 24 satellites x
@@ -176,8 +176,8 @@ def _print_table(out, const, args, week, sow, vis, d):
 
 
 class _Output:
-    """Lines to stdout; when the reader goes away (``| head``) the rest is dropped quietly: stdout is pointed at
-    os.devnull so that neither this writer nor the interpreter's final flush raises BrokenPipeError."""
+    """Lines to stdout; when the reader goes away (``| head``) the rest is dropped quietly
+    (:func:`simkit.commands.silence_stdout`) and the command carries on to its plot."""
 
     def __init__(self):
         self.closed = False
@@ -189,9 +189,7 @@ class _Output:
             print(text, flush=True)
         except BrokenPipeError:
             self.closed = True
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, sys.stdout.fileno())
-            os.close(devnull)
+            silence_stdout()
 
 
 def _sky_plot(path, kind, const, geo, vis, title):
@@ -214,20 +212,6 @@ def _sky_plot(path, kind, const, geo, vis, title):
         ax.plot(az, el, ".", ms=3, color=colors.get(sid[0], "k"))
         ax.annotate(f"{sid} {const.orbit_type[s][0]}", (az[-1], el[-1]), fontsize=7)
     ax.set_title(title, fontsize=9)
-    _save_atomically(fig, Path(path), kind)
+    with atomic_open(path, "wb") as f:  # a failure never leaves a partial image under the name
+        fig.savefig(f, format=kind, dpi=120)
     plt.close(fig)
-
-
-def _save_atomically(fig, path: Path, kind: str):
-    """Write under a temporary name in the same folder and rename: a failure never leaves a partial image."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            fig.savefig(f, format=kind, dpi=120)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 -> what open() would have given
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise

@@ -10,6 +10,7 @@ import shlex
 import sys
 from pathlib import Path
 
+from ..atomic import atomic_open
 from ..errors import OutputError, ScenarioError
 
 
@@ -107,4 +108,5 @@ def _write(args, v, report):
         command = "simkit validate " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == \
             ["validate"] else ""
         text = rp.markdown(v, figures, command).encode()
-        rp._atomic_write(report / "report.md", lambda f: f.write(text))
+        with atomic_open(report / "report.md", "wb") as f:
+            f.write(text)

@@ -7,15 +7,14 @@ indicator carries the /gnss/obs LLI bits, the signal-strength indicator is min(m
 """
 from __future__ import annotations
 
-import os
 import shutil
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
 import numpy as np
 
-from .. import gpstime
-from .. import frames
+from .. import frames, gpstime
+from ..atomic import atomic_open
 from ..earth import C_LIGHT
 from ..version import __version__
 from . import signals as sigmod
@@ -132,13 +131,8 @@ def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, ap
                 cols += [(o["code"], None, ssi), (o["carrier"], lli, ssi), (o["doppler"], None, None),
                          (o["cn0"], None, None)]
         columns[sys] = cols
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    try:
-        with open(tmp, "w") as f:
-            _write_epochs(f, head, start_week, start_sow, t, tag, sat_ids, columns)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    with atomic_open(path, "w") as f:
+        _write_epochs(f, head, start_week, start_sow, t, tag, sat_ids, columns)
     return path
 
 

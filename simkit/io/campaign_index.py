@@ -13,6 +13,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from ..atomic import atomic_path
 from . import schema
 from .schema import SCHEMA_VERSION
 
@@ -38,9 +39,8 @@ def write_campaign_index(path, columns: dict[str, list], run_files: list, stack=
     """Write the index to ``path``: ``columns`` name -> R values (str, or numbers/None); ``run_files`` the
     completed run files and ``stack`` the dataset paths to stack over them. Returns the stacked paths."""
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
     stacked = []
-    try:
+    with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as f:
             f.attrs["schema_version"] = SCHEMA_VERSION
             f.attrs["kind"] = "campaign_index"
@@ -57,7 +57,4 @@ def write_campaign_index(path, columns: dict[str, list], run_files: list, stack=
                 schema.check(name, np.dtype(dtype), (len(run_files),) + shape)
                 f.create_virtual_dataset(name, layout, fillvalue=None)
                 stacked.append(p)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
     return stacked

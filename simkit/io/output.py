@@ -7,7 +7,7 @@ import shutil
 from pathlib import Path
 
 from ..errors import OutputError
-from .writer import temporary_name
+from ..atomic import temporary_name
 
 
 def check_output(out, inputs=(), estimated_bytes: int = 0, force: bool = False) -> Path:

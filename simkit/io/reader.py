@@ -43,10 +43,9 @@ class Array:
         return self.shape[0] if self.shape else 0
 
     def __getitem__(self, key) -> np.ndarray:
-        data = self._ds[key]
         if h5py.check_string_dtype(self._ds.dtype) is not None:
-            data = np.asarray(self._ds.asstr()[key], dtype=str)
-        return np.asarray(data)
+            return np.asarray(self._ds.asstr()[key], dtype=str)
+        return np.asarray(self._ds[key])
 
     def __array__(self, dtype=None, copy=None):
         data = self[()]

@@ -19,6 +19,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from ..atomic import remove_stale_temporaries, temporary_name
 from ..version import __version__
 from . import schema
 from .schema import SCHEMA_VERSION
@@ -40,32 +41,6 @@ def _shuffle_deflate(chunk: np.ndarray) -> bytes:
     """The bytes HDF5's shuffle + deflate(level 1) filters make of one full chunk."""
     raw = np.ascontiguousarray(chunk).view(np.uint8).reshape(-1, chunk.dtype.itemsize)
     return deflate.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
-
-
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's live process
-        return True
-    return True
-
-
-def temporary_name(path: Path, pid: int | None = None) -> Path:
-    """Where ``path`` is written until it is complete: a hidden name with the writer's process id."""
-    return path.with_name(f".{path.name}.tmp-{os.getpid() if pid is None else pid}")
-
-
-def remove_stale_temporaries(path: Path) -> list[Path]:
-    """Remove the temporary files of ``path`` left by writers that died (SIGKILL, power loss); returns them."""
-    removed = []
-    for tmp in path.parent.glob(f".{path.name}.tmp-*"):
-        pid = tmp.name.rsplit("-", 1)[-1]
-        if pid.isdigit() and int(pid) != os.getpid() and not _pid_alive(int(pid)):
-            tmp.unlink(missing_ok=True)
-            removed.append(tmp)
-    return removed
 
 
 class _Series:

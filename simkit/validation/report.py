@@ -3,32 +3,21 @@ of Wang 2018 Figs 2-5 (visible satellites; each ATDOP against its observable deg
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from ..atomic import atomic_open
 
 ANGLES = (("pitch", "PIDOP"), ("roll", "RDOP"), ("yaw", "YDOP"))
 PLOT_STEP_S = 60.0      # one plotted point a minute keeps each PNG near 50 kB
 
 
-def _atomic_write(path: Path, write) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            write(f)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def write_json(path, summary: dict) -> None:
     """``summary`` as indented JSON at ``path`` (written under a temporary name, then renamed)."""
     text = json.dumps(summary, indent=1, allow_nan=False, default=_jsonable).encode()
-    _atomic_write(Path(path), lambda f: f.write(text))
+    with atomic_open(path, "wb") as f:
+        f.write(text)
 
 
 def _jsonable(x):
@@ -75,7 +64,8 @@ def plots(folder: Path, v, config: str = "three") -> list[str]:
 
 def _save(fig, folder: Path, name: str) -> str:
     fig.tight_layout()
-    _atomic_write(folder / name, lambda f: fig.savefig(f, format="png", dpi=72))
+    with atomic_open(folder / name, "wb") as f:
+        fig.savefig(f, format="png", dpi=72)
     import matplotlib.pyplot as plt
 
     plt.close(fig)
