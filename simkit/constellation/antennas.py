@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import earth, frames
 from ..earth import C_LIGHT, OMEGA_E
-from .geometry import elevation_azimuth
+from .geometry import angles_from_enu
 
 _OMEGA = np.array([0.0, 0.0, OMEGA_E])
 
@@ -56,11 +56,8 @@ def antenna_view(ref: dict, ant_pos: np.ndarray, ant_vel: np.ndarray) -> Antenna
     u = diff / rng[..., None]
     v_r = ant_vel[:, :, None, :] + np.cross(_OMEGA, r)
     rr = np.einsum("masi,masi->mas", u, v_in - v_r) / (1.0 + np.einsum("masi,masi->mas", u, v_in) / C_LIGHT)
-    m, a = ant_pos.shape[:2]
-    el, az = elevation_azimuth(ant_pos.reshape(m * a, 3), u.reshape(m * a, -1, 3))
-    el, az = el.reshape(rng.shape), az.reshape(rng.shape)
-    el_rate, az_rate, lla, vel_enu = _angle_rates(u, rng, ref["sat_vel"][:, None] - ant_vel[:, :, None, :], ant_pos,
-                                             ant_vel)
+    el, az, el_rate, az_rate, lla, vel_enu = _angles(u, rng, ref["sat_vel"][:, None] - ant_vel[:, :, None, :],
+                                                     ant_pos, ant_vel)
     clock = ref["sat_clock"][:, None] - ref["sat_drift"][:, None] * d
     drift = np.broadcast_to(ref["sat_drift"][:, None], clock.shape)
     return AntennaView(rng, rr, u, el, az, el_rate, az_rate, clock, drift, lla, vel_enu)
@@ -74,9 +71,10 @@ def _extra_light_time(x0, v_in, tau0, r, iterations: int = 2):
     return d
 
 
-def _angle_rates(u, rng, rel_vel, ant_pos, ant_vel):
-    """Elevation and azimuth rates (rad/s) from the line-of-sight rate in ECEF (rotating-frame relative velocity
-    ``rel_vel`` (M, A, S, 3)); the antennas' geodetic position (M, A, 3) and ENU velocity (M, A, 3) m/s."""
+def _angles(u, rng, rel_vel, ant_pos, ant_vel):
+    """Elevation and azimuth (rad) of the lines of sight ``u`` (M, A, S, 3) at each antenna, and their rates
+    (rad/s) from the line-of-sight rate in ECEF (rotating-frame relative velocity ``rel_vel`` (M, A, S, 3)); the
+    antennas' geodetic position (M, A, 3) and ENU velocity (M, A, 3) m/s."""
     u_dot = (rel_vel - u * np.einsum("masi,masi->mas", u, rel_vel)[..., None]) / rng[..., None]
     lla = frames.ecef_to_lla(ant_pos.reshape(-1, 3)).reshape(ant_pos.shape)
     c_en = frames.ecef_to_enu_matrix(lla[..., 0], lla[..., 1])    # (M, A, 3, 3)
@@ -88,4 +86,5 @@ def _angle_rates(u, rng, rel_vel, ant_pos, ant_vel):
     el_rate = enu_dot[..., 2] / np.sqrt(np.maximum(1.0 - enu[..., 2] ** 2, 1e-12))
     hz = enu[..., 0] ** 2 + enu[..., 1] ** 2
     az_rate = (enu[..., 1] * enu_dot[..., 0] - enu[..., 0] * enu_dot[..., 1]) / np.maximum(hz, 1e-12)
-    return el_rate, az_rate, lla, vel_enu
+    el, az = angles_from_enu(enu)
+    return el, az, el_rate, az_rate, lla, vel_enu

@@ -99,7 +99,12 @@ def elevation_azimuth(rx_pos, los):
     ``rx_pos`` (M, 3) m ECEF (geodetic vertical, WGS-84). Azimuth clockwise from north in [0, 2 pi)."""
     lla = frames.ecef_to_lla(np.atleast_2d(rx_pos))
     c = frames.ecef_to_enu_matrix(lla[:, 0], lla[:, 1])  # (M, 3, 3)
-    enu = np.einsum("mij,msj->msi", c, los)
+    return angles_from_enu(np.einsum("mij,msj->msi", c, los))
+
+
+def angles_from_enu(enu):
+    """Elevation and azimuth (rad) of unit vectors ``enu`` (..., 3) in a local ENU frame; azimuth clockwise
+    from north in [0, 2 pi)."""
     el = np.arcsin(np.clip(enu[..., 2], -1.0, 1.0))
     az = np.mod(np.arctan2(enu[..., 0], enu[..., 1]), 2.0 * np.pi)
     return el, az
