@@ -195,3 +195,54 @@ def test_partial_fixing_fixes_true_integer_combinations_and_shrinks_the_baseline
     assert np.mean(right) >= 0.9  # each subset was chosen with bootstrapped success rate >= 0.99
     for i in part:
         assert np.trace(res.Qb[i]) < np.trace(grp.Qb[i])
+
+
+def _stacked_gls(obs, epochs, static):
+    """Independent construction of the multi-epoch float: every epoch's DD carrier and code (simkit.gnss
+    differencing) stacked in one weighted least squares with the ambiguities common and the baseline per epoch
+    (or common, ``static``). Returns (a, Qa, b of the last epoch, Qb, Qba)."""
+    ref = differencing.reference_satellites(obs.elevation, np.ones(obs.elevation.shape, bool), obs.sat_ids)
+    n_e, lam = len(epochs), obs.wavelength[0]
+    nb = 6 if static else 6 * n_e
+    Hs, ys, Qs = [], [], []
+    for j, m in enumerate(epochs):
+        D, ant, sat = differencing.dd_operator(ref[m], np.ones(8, bool), 3)
+        e = obs.los[m]
+        G1 = -(e[sat] - e[ref[m][sat]])
+        Gk = np.zeros((len(sat), 6))
+        for k in (1, 2):
+            Gk[ant == k, 3 * (k - 1):3 * k] = G1[ant == k]
+        rn = len(sat)
+        Hphi, Hp = np.zeros((rn, nb + rn)), np.zeros((rn, nb + rn))
+        col = slice(0, 6) if static else slice(6 * j, 6 * j + 6)
+        Hphi[:, col], Hp[:, col] = Gk, Gk
+        Hphi[:, nb:] = lam * np.eye(rn)
+        Hs += [Hphi, Hp]
+        ys += [D @ (obs.carrier[0, m] * lam).ravel(), D @ obs.code[0, m].ravel()]
+        Qs += [(D * obs.var_carrier[0, m].ravel()) @ D.T, (D * obs.var_code[0, m].ravel()) @ D.T]
+    H, y = np.concatenate(Hs), np.concatenate(ys)
+    W = np.linalg.inv(np.block([[Q if i == j else np.zeros((len(Q), len(P))) for j, P in enumerate(Qs)]
+                                for i, Q in enumerate(Qs)]))
+    P = np.linalg.inv(H.T @ W @ H)
+    x = P @ H.T @ W @ y
+    b = slice(nb - 6, nb)
+    return x[nb:], P[nb:, nb:], x[b], P[b, b], P[b, nb:]
+
+
+@pytest.mark.parametrize("static", [False, True])
+def test_multi_epoch_float_equals_the_stacked_least_squares_and_resets_at_a_loss_of_lock(static):
+    rng = np.random.default_rng(9)
+    obs, _ = _obs(rng, attitude_from_euler(0.02, -0.01, 0.4).as_matrix(), m=7)
+    lli = np.zeros(obs.carrier.shape, np.uint8)
+    lli[0, 4, 2, 3] = 1  # antenna 2, satellite 3 at epoch 4: the window restarts there
+    (single,) = float_solution(obs)
+    (grp,) = float_solution(obs, epochs=3, static=static, lli=lli)
+    for last, window in ((2, [0, 1, 2]), (3, [1, 2, 3]), (4, [4]), (6, [4, 5, 6])):
+        a, Qa, b, Qb, Qba = _stacked_gls(obs, window, static)
+        assert np.allclose(grp.a_hat[last], a, atol=1e-6) and np.allclose(grp.Qa[last], Qa, rtol=1e-7, atol=1e-12)
+        assert np.allclose(grp.b_hat[last], b, atol=1e-8) and np.allclose(grp.Qb[last], Qb, rtol=1e-7, atol=1e-14)
+        assert np.allclose(grp.Qba[last], Qba, rtol=1e-7, atol=1e-13)
+    assert np.allclose(grp.a_hat[4], single.a_hat[4]) and np.allclose(grp.Qa[4], single.Qa[4])
+    # three epochs of (nearly) the same geometry: about a third of the single-epoch ambiguity variance
+    ratio = np.trace(grp.Qa[2]) / np.trace(single.Qa[2])
+    assert 0.3 < ratio < 0.36 if not static else ratio < 0.34

@@ -11,6 +11,16 @@ code (the carrier carries a free ambiguity per row), the float ambiguities from 
 with G = I_r (x) G_1 (baseline-major rows) and Qphi, Qp = D diag(sigma^2) D' from the undifferenced variances
 (so the rows of different baselines that share antenna 0 are correlated, as they are). Epochs are grouped by
 their channel pattern (which satellites / references / signals); every group is solved in one batch.
+
+Several epochs (``epochs`` = N > 1): the ambiguities are constant over a window of the last N epochs of a run (a
+run: consecutive epochs of one channel pattern without a loss-of-lock flag on any antenna for a satellite or
+reference used; the window is shorter at the start of a run), the noise white in time. Kinematic (baseline per
+epoch): the window's ambiguities are the information-weighted mean of the single-epoch floats,
+Qa_w = (sum_k Qa_k^-1)^-1, a_w = Qa_w sum_k Qa_k^-1 a_k, and epoch j's baseline is conditioned on them,
+b_j = b_hat_j + Qba_j Qa_j^-1 (a_w - a_j), Qba_w = Qba_j Qa_j^-1 Qa_w,
+Qb_w = Qb_j - Qba_j Qa_j^-1 (Qa_j - Qa_w) Qa_j^-1 Qab_j (a Kalman update of epoch j's (b, a) by the other
+epochs' independent ambiguity information). Static (one baseline over the window): the joint (b, a) of every
+epoch combined the same way with its full covariance. Time-correlated errors (multipath) make both optimistic.
 """
 from __future__ import annotations
 
@@ -131,11 +141,65 @@ def _patterns(usable, ref):
     return groups
 
 
-def float_solution(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None) -> list[FloatGroup]:
-    """Float DD solutions of every epoch with at least 3 DD channels, grouped by channel pattern."""
+def float_solution(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None, epochs: int = 1,
+                   static: bool = False, lli: np.ndarray | None = None) -> list[FloatGroup]:
+    """Float DD solutions of every epoch with at least 3 DD channels, grouped by channel pattern; with
+    ``epochs`` > 1 each over the window of the last ``epochs`` epochs (module docstring), ``static`` with one
+    baseline over the window, windows reset at a gap and at a loss-of-lock flag of ``lli`` (G, M, A, S)."""
+    if int(epochs) < 1:
+        raise AttitudeInputError("epochs", f"{epochs}; expected an integer >= 1")
     usable = channel_masks(obs, mask_rad, max_sats)
     ref = references(obs, usable)
-    return [_solve_group(obs, *grp) for grp in _patterns(usable, ref)]
+    groups = [_solve_group(obs, *grp) for grp in _patterns(usable, ref)]
+    if int(epochs) == 1:
+        return groups
+    return [multi_epoch(grp, run_breaks(grp, lli), int(epochs), static) for grp in groups]
+
+
+def run_breaks(grp: FloatGroup, lli: np.ndarray | None) -> np.ndarray:
+    """(K,) bool: where a run of the group's epochs starts: the first epoch, after a gap, or at a loss-of-lock
+    flag (``lli`` (G, M, A, S) > 0; None: none) on any antenna for a satellite or reference used."""
+    e = grp.epochs
+    out = np.ones(len(e), bool)
+    out[1:] = np.diff(e) != 1
+    if lli is not None:
+        flags = lli[grp.signal[:, None], e[None, :]][:, :, :, np.concatenate([grp.sat, grp.ref])] > 0
+        out |= flags.any(axis=(0, 2, 3))
+    return out
+
+
+def _window_sum(x: np.ndarray, start: np.ndarray, n: int) -> np.ndarray:
+    """sum of x[j - l] for l = 0 .. n-1 with j - l >= start[j] (the run's first index), along axis 0."""
+    out = x.copy()
+    idx = np.arange(len(x))
+    for lag in range(1, min(n, len(x))):
+        ok = idx - lag >= start
+        out[ok] += x[idx[ok] - lag]
+    return out
+
+
+def multi_epoch(grp: FloatGroup, breaks: np.ndarray, n: int, static: bool = False) -> FloatGroup:
+    """The group's floats over windows of the last ``n`` epochs of each run (``breaks`` (K,) run starts)."""
+    start = np.maximum.accumulate(np.where(breaks, np.arange(len(breaks)), 0))
+    if static:
+        x = np.concatenate([grp.b_hat, grp.a_hat], 1)
+        P = np.block([[grp.Qb, grp.Qba], [np.swapaxes(grp.Qba, 1, 2), grp.Qa]])
+        info = np.linalg.inv(P)
+        P_w = np.linalg.inv(_window_sum(info, start, n))
+        x_w = np.einsum("kij,kj->ki", P_w, _window_sum(np.einsum("kij,kj->ki", info, x), start, n))
+        nb = grp.b_hat.shape[1]
+        P_w = 0.5 * (P_w + np.swapaxes(P_w, 1, 2))
+        return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, x_w[:, nb:], P_w[:, nb:, nb:], x_w[:, :nb],
+                          P_w[:, :nb, :nb], P_w[:, :nb, nb:], grp.G, grp.Qphi)
+    info = np.linalg.inv(grp.Qa)
+    Qa_w = np.linalg.inv(_window_sum(info, start, n))
+    Qa_w = 0.5 * (Qa_w + np.swapaxes(Qa_w, 1, 2))
+    a_w = np.einsum("kij,kj->ki", Qa_w, _window_sum(np.einsum("kij,kj->ki", info, grp.a_hat), start, n))
+    T = grp.Qba @ info  # Qba Qa^-1
+    b_w = grp.b_hat + np.einsum("kij,kj->ki", T, a_w - grp.a_hat)
+    Qb_w = grp.Qb - T @ (grp.Qa - Qa_w) @ np.swapaxes(T, 1, 2)
+    return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, a_w, Qa_w, b_w, 0.5 * (Qb_w + np.swapaxes(Qb_w, 1, 2)),
+                      T @ Qa_w, grp.G, grp.Qphi)
 
 
 def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:

@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 from ..frames import euler_from_attitude
 from ..solution import Solution
 from . import wahba
-from .dd import FloatGroup, dd_operator, float_solution
+from .dd import FloatGroup, dd_operator, float_solution, run_breaks
 from .errors import AttitudeInputError
 from .params import AMBIGUITY_DEFAULTS, merge
 from .reading import FileData, read
@@ -44,11 +44,7 @@ def _wrong(grp: FloatGroup, res: Resolution, fd: FileData) -> np.ndarray:
 def continuity_breaks(grp: FloatGroup, lli: np.ndarray) -> np.ndarray:
     """(K,) bool: the group's epochs where ambiguity continuity breaks: the first, after a gap in the epochs, or
     with a loss-of-lock flag (``lli`` (G, M, A, S) > 0) on any antenna for a satellite or reference used."""
-    e = grp.epochs
-    gap = np.ones(len(e), bool)
-    gap[1:] = np.diff(e) != 1
-    flags = lli[grp.signal[:, None], e[None, :]][:, :, :, np.concatenate([grp.sat, grp.ref])] > 0  # (n, K, A, 2n)
-    return gap | flags.any(axis=(0, 2, 3))
+    return run_breaks(grp, lli)
 
 
 def _attitude(res: Resolution, F: np.ndarray, method: str, kind: str):
@@ -119,7 +115,8 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
     single = p["attitude"] == "baseline" or F.shape[1] == 1
     names = ("pitch", "heading") if single else ("pitch", "roll", "heading")
     out = _empty(M, a - 1, g, s, names)
-    groups = float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None)
+    groups = float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None, p["float_epochs"],
+                            bool(p["static"]), fd.lli)
     for grp in _progress(groups, progress, f"attitude ({method})"):
         kw = dict(ratio_threshold=p["ratio_threshold"], partial_p0=p["partial_p0"] or None,
                   max_nodes=int(p["max_nodes"]))

@@ -89,7 +89,8 @@ def fixed_dd(fd: FileData, method: str, p: dict) -> FixedDD:
     F = body_baselines(fd.lever_arm)
     kw = dict(ratio_threshold=p["ratio_threshold"], partial_p0=None, max_nodes=int(p["max_nodes"]))
     rows = []
-    for grp in float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None):
+    for grp in float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None, p["float_epochs"],
+                              bool(p["static"]), fd.lli):
         if p["continuity"] and p["every"] == 1:
             res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), **kw)
         else:
