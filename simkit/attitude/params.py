@@ -42,6 +42,9 @@ TDCP_DEFAULTS = {
     "stop_s": float("inf"),
     "every": 1,                   # difference every n-th epoch with the one before it
     "troposphere": 1,             # 1: remove the modelled troposphere change (Saastamoinen, at the code position)
+    "lever_attitude": "auto",     # attitude for the IMU-centre velocity: attitude (solver), truth, none; auto:
+                                  # the solver with 3+ antennas, else none
+    "lever_rate": "attitude",     # turn of the lever arm from the attitude at both ends ("attitude") or the IMU gyro
 }
 
 

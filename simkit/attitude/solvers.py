@@ -166,7 +166,5 @@ def solver(name: str):
 
 
 def build_registry() -> dict:
-    from .tdcp import solve_tdcp
-    reg = {name: solver(name) for name in _METHOD}
-    reg["tdcp"] = solve_tdcp
-    return reg
+    """The carrier-phase attitude solvers by name (``simkit.attitude.SOLVERS`` adds ``tdcp``)."""
+    return {name: solver(name) for name in _METHOD}
