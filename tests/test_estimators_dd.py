@@ -189,3 +189,31 @@ def test_kf15_dd_attitude_nees_is_within_the_chi2_bounds_over_a_monte_carlo(tmp_
     res = attitude_nees("airborne_stim300", runs=6, seconds=150.0, skip_s=60.0, workdir=tmp_path)
     lo, hi = res["bounds_95"]
     assert lo < res["nees_mean"] < hi and res["fraction_inside"] > 0.75, res
+
+
+def test_kf15_dd_on_a_static_site_aligns_automatically_from_the_fixed_attitude(xian):
+    """Issue 12: ``simkit solve xian.h5 --filter kf15_dd`` with no align key: "auto" takes the carrier-phase
+    attitude (3 antennas fix), reports it, and the heading is held to the DD level (a MEMS gyro cannot
+    gyrocompass: "static" would start degrees off and the gate would reject the DD rows)."""
+    proc = run_cli(["solve", str(xian), "--filter", "kf15_dd", "-q"], xian.parent)
+    assert proc.returncode == 0, proc.stderr
+    sol = read_solution(xian, "kf15_dd")
+    assert sol.config["align_used"] == "attitude" and sol.config["params"]["align"] == "auto"
+    with simkit.open(xian) as ds:
+        q, _, _ = truth_at(ds, sol.t)
+    err = (Rotation.from_quat(sol.quat_nb) * Rotation.from_quat(q).inv()).magnitude()
+    assert np.degrees(err[sol.t > 30]).max() < 0.2 and sol.config["dd_rejected"] == 0
+
+
+def test_auto_alignment_is_static_on_a_stationary_start_and_in_motion_otherwise(tmp_path):
+    """quickstart (2 antennas: no 3-antenna attitude) stands still for 5 s, then drives off."""
+    from simkit.estimators import registry
+
+    path = simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=30"])
+    with simkit.open(path) as ds:
+        for span, want in ((4.0, "static"), (10.0, "motion")):
+            p = registry.merged("kf15_dd", {"align_static_s": span})
+            imu, gnss = registry.imu_data(ds), registry.gnss_fixes(ds, p)
+            assert registry.resolve_align(ds, p, imu, gnss) == (want, None)
+        sol = SOLVERS["kf15_dd"](ds, {"align_static_s": 4.0}, False)
+        assert sol.config["align_used"] == "static"
