@@ -273,3 +273,39 @@ def test_lever_arm_velocity_of_a_steady_turn_matches_the_closed_form():
     assert np.allclose(vm * np.sin(w * dt / 2) / (w * dt / 2), v, atol=1e-12)  # chord vs arc at the midpoint
     # covariance: |v| sd of attitude 1 mrad in the plane of v and the rate noise 1e-4 rad/s x |l x axis|
     assert np.all(np.linalg.eigvalsh(cr) > 0)
+
+
+def test_weighted_atdop_is_the_attitude_sd_of_the_weighted_fit_through_the_baselines():
+    """Weighted ATDOP x s = the Euler sd of the carrier-only fit with the DD covariance Q, computed the other
+    way round: fixed baselines Qb = (G' Q^-1 G)^-1 of the DD rows, then phi_covariance and euler_covariance.
+    Unit weights (Q = s^2 I) give Wang's ATDOP."""
+    from simkit.attitude.wahba import euler_covariance
+    rng = np.random.default_rng(11)
+    R = attitude_from_euler(0.05, -0.03, 2.2).as_matrix()[None]
+    los, el = _sky(rng, 1, 8)
+    G1 = -(los[:, 1:] - los[:, :1])  # (1, 7, 3) against satellite 0
+    sig = 0.002 / np.sin(el[0])  # elevation-dependent undifferenced sd, m
+    D = np.zeros((14, 3 * 8))  # DD of antennas (0, 1, 2) x 8 satellites, baseline-major
+    for k in (1, 2):
+        for i in range(7):
+            for a, sa in ((k, 1), (0, -1)):
+                D[(k - 1) * 7 + i, a * 8 + i + 1] += sa
+                D[(k - 1) * 7 + i, a * 8] -= sa
+    Q = (D * np.tile(sig ** 2, 3)) @ D.T
+    Gb = np.kron(np.eye(2), G1[0])
+    Qb = np.linalg.inv(Gb.T @ np.linalg.solve(Q, Gb))[None]
+    sd = np.sqrt(np.diagonal(euler_covariance(R, phi_covariance(R, F, Qb)), axis1=1, axis2=2))
+    s = np.sqrt(np.mean(np.diag(Q)))
+    assert np.allclose(atdop(R, F, G1, Q[None]) * s, sd, rtol=1e-6)
+    assert np.allclose(atdop(R, F, G1, np.eye(14)[None] * 3e-6), atdop(R, F, G1), rtol=1e-9)
+    assert not np.allclose(atdop(R, F, G1, Q[None]), atdop(R, F, G1), rtol=0.05)
+
+
+def test_correlation_inflation_is_the_variance_of_the_mean_of_a_gauss_markov_sequence():
+    from simkit.attitude.tight import correlation_inflation
+    tau, dt, n = 30.0, 1.0, 40
+    rho = np.exp(-dt / tau)
+    C = rho ** np.abs(np.subtract.outer(np.arange(n), np.arange(n)))  # unit-variance AR(1) covariance
+    assert np.isclose(correlation_inflation(tau, dt, n), C.sum() / n, rtol=1e-12)  # n Var(mean) / sigma^2
+    assert np.isclose(correlation_inflation(tau, dt), (1 + rho) / (1 - rho), rtol=1e-12)
+    assert correlation_inflation(0.0, dt) == 1.0

@@ -38,7 +38,9 @@ class Observations:
 
     ``carrier`` (G, M, A, S) cycles; ``code`` (G, M, A, S) m; ``var_carrier`` / ``var_code`` (G, M, A, S) m^2
     undifferenced variances; ``wavelength`` (G,) m; ``los`` (M, S, 3) unit lines of sight receiver -> satellite
-    in ENU; ``elevation`` (M, S) rad; ``sat_ids`` (S,) str (the system is the first letter).
+    in ENU; ``elevation`` (M, S) rad; ``sat_ids`` (S,) str (the system is the first letter);
+    ``var_carrier_correlated`` (G, M, A, S) m^2 the part of ``var_carrier`` that is correlated in time
+    (multipath), or None.
     """
 
     carrier: np.ndarray
@@ -49,13 +51,14 @@ class Observations:
     los: np.ndarray
     elevation: np.ndarray
     sat_ids: np.ndarray
+    var_carrier_correlated: np.ndarray | None = None
 
     def __post_init__(self):
         shape = np.shape(self.carrier)
         if len(shape) != 4:
             raise AttitudeInputError("carrier", f"shape {shape}; expected (G, M, A, S)")
-        for name in ("code", "var_carrier", "var_code"):
-            if np.shape(getattr(self, name)) != shape:
+        for name in ("code", "var_carrier", "var_code", "var_carrier_correlated"):
+            if getattr(self, name) is not None and np.shape(getattr(self, name)) != shape:
                 raise AttitudeInputError(name, f"shape {np.shape(getattr(self, name))}; expected {shape}")
         g, m, a, s = shape
         if a < 2:
@@ -72,7 +75,8 @@ class FloatGroup:
     ``epochs`` (K,) indices into the M epochs; ``signal``, ``sat``, ``ref`` (n,) of each channel; ``a_hat`` (K, r n)
     cycles (baseline-major); ``Qa`` (K, r n, r n) cycles^2; ``b_hat`` (K, 3 r) m ENU; ``Qb`` (K, 3 r, 3 r) m^2;
     ``Qba`` (K, 3 r, r n) m cycles; ``G`` (K, n, 3) DD geometry (m per m of baseline); ``Qphi`` (K, r n, r n)
-    DD carrier covariance m^2.
+    DD carrier covariance m^2; ``Qphi_correlated`` (K, r n, r n) its time-correlated part (from
+    ``Observations.var_carrier_correlated``, when asked for: ``float_solution(..., correlated=True)``), or None.
     """
 
     epochs: np.ndarray
@@ -86,6 +90,7 @@ class FloatGroup:
     Qba: np.ndarray
     G: np.ndarray
     Qphi: np.ndarray
+    Qphi_correlated: np.ndarray | None = None
 
 
 def channel_masks(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None) -> np.ndarray:
@@ -142,15 +147,16 @@ def _patterns(usable, ref):
 
 
 def float_solution(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None, epochs: int = 1,
-                   static: bool = False, lli: np.ndarray | None = None) -> list[FloatGroup]:
+                   static: bool = False, lli: np.ndarray | None = None, correlated: bool = False) -> list[FloatGroup]:
     """Float DD solutions of every epoch with at least 3 DD channels, grouped by channel pattern; with
     ``epochs`` > 1 each over the window of the last ``epochs`` epochs (module docstring), ``static`` with one
-    baseline over the window, windows reset at a gap and at a loss-of-lock flag of ``lli`` (G, M, A, S)."""
+    baseline over the window, windows reset at a gap and at a loss-of-lock flag of ``lli`` (G, M, A, S);
+    ``correlated``: also the time-correlated part of the DD carrier covariance (``Qphi_correlated``)."""
     if int(epochs) < 1:
         raise AttitudeInputError("epochs", f"{epochs}; expected an integer >= 1")
     usable = channel_masks(obs, mask_rad, max_sats)
     ref = references(obs, usable)
-    groups = [_solve_group(obs, *grp) for grp in _patterns(usable, ref)]
+    groups = [_solve_group(obs, *grp, correlated=correlated) for grp in _patterns(usable, ref)]
     if int(epochs) == 1:
         return groups
     return [multi_epoch(grp, run_breaks(grp, lli), int(epochs), static) for grp in groups]
@@ -190,7 +196,7 @@ def multi_epoch(grp: FloatGroup, breaks: np.ndarray, n: int, static: bool = Fals
         nb = grp.b_hat.shape[1]
         P_w = 0.5 * (P_w + np.swapaxes(P_w, 1, 2))
         return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, x_w[:, nb:], P_w[:, nb:, nb:], x_w[:, :nb],
-                          P_w[:, :nb, :nb], P_w[:, :nb, nb:], grp.G, grp.Qphi)
+                          P_w[:, :nb, :nb], P_w[:, :nb, nb:], grp.G, grp.Qphi, grp.Qphi_correlated)
     info = np.linalg.inv(grp.Qa)
     Qa_w = np.linalg.inv(_window_sum(info, start, n))
     Qa_w = 0.5 * (Qa_w + np.swapaxes(Qa_w, 1, 2))
@@ -199,10 +205,10 @@ def multi_epoch(grp: FloatGroup, breaks: np.ndarray, n: int, static: bool = Fals
     b_w = grp.b_hat + np.einsum("kij,kj->ki", T, a_w - grp.a_hat)
     Qb_w = grp.Qb - T @ (grp.Qa - Qa_w) @ np.swapaxes(T, 1, 2)
     return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, a_w, Qa_w, b_w, 0.5 * (Qb_w + np.swapaxes(Qb_w, 1, 2)),
-                      T @ Qa_w, grp.G, grp.Qphi)
+                      T @ Qa_w, grp.G, grp.Qphi, grp.Qphi_correlated)
 
 
-def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:
+def _solve_group(obs: Observations, epochs, signal, sat, ref, correlated: bool = False) -> FloatGroup:
     """Batch least squares of one channel pattern (see the module docstring)."""
     n_ant = obs.carrier.shape[2]
     r, n = n_ant - 1, len(sat)
@@ -219,6 +225,9 @@ def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:
     y_p = take(obs.code) @ D.T
     Qphi = np.einsum("ij,kj,lj->kil", D, take(obs.var_carrier), D, optimize=True)
     Qp = np.einsum("ij,kj,lj->kil", D, take(obs.var_code), D, optimize=True)
+    Qc = None
+    if correlated and obs.var_carrier_correlated is not None:
+        Qc = np.einsum("ij,kj,lj->kil", D, take(obs.var_carrier_correlated), D, optimize=True)
     e = obs.los[epochs]
     G1 = -(e[:, sat, :] - e[:, ref, :])  # (K, n, 3)
     G = np.zeros((len(epochs), r * n, 3 * r))
@@ -233,4 +242,4 @@ def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:
     Qa = (Qphi + GQb @ np.swapaxes(G, 1, 2)) / np.outer(lam, lam)
     Qa = 0.5 * (Qa + np.swapaxes(Qa, 1, 2))
     Qba = -np.swapaxes(GQb, 1, 2) / lam
-    return FloatGroup(epochs, signal, sat, ref, a_hat, Qa, b_hat, Qb, Qba, G1, Qphi)
+    return FloatGroup(epochs, signal, sat, ref, a_hat, Qa, b_hat, Qb, Qba, G1, Qphi, Qc)

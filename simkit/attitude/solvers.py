@@ -81,6 +81,7 @@ def _empty(M: int, r: int, g: int, s: int, names) -> dict:
             "dd_ambiguity_true": np.full((M, r, g, s), nan), "reference_sat": np.full((M, g, s), -1, np.int16),
             "baseline_enu": np.full((M, r, 3), nan), "baseline_body": np.full((M, r, 3), nan),
             "baseline_float_enu": np.full((M, r, 3), nan), "atdop": np.full((M, 3), nan),
+            "atdop_weighted": np.full((M, 3), nan),
             "sigma_dd_carrier": np.full(M, nan)}
 
 
@@ -128,6 +129,7 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
         _store(out, grp, res, fd, R, cov)
         if not single:
             out["atdop"][grp.epochs] = wahba.atdop(R, F, grp.G)
+            out["atdop_weighted"][grp.epochs] = wahba.atdop(R, F, grp.G, grp.Qphi)
     if single:
         out["euler"][:, 1] = np.nan
     return out, names
@@ -137,7 +139,8 @@ _UNITS = {"status": "-1 none, 0 float, 1 fixed, 2 partial, 3 wrong fix", "ratio"
           "success_rate": "1",
           "n_sats": "1", "dd_ambiguity": "cycles", "dd_ambiguity_true": "cycles",
           "reference_sat": "index into /gnss/sat_id", "baseline_enu": "m", "baseline_body": "m",
-          "baseline_float_enu": "m", "atdop": "rad/m", "sigma_dd_carrier": "m"}
+          "baseline_float_enu": "m", "atdop": "rad/m", "atdop_weighted": "rad/m (x sigma_dd_carrier: the weighted "
+          "fit's sd)", "sigma_dd_carrier": "m"}
 
 
 def solver(name: str):

@@ -32,7 +32,8 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
                      "lever_arm_error_m": [0.0, 0.0, 0.0], "attitude_source": "auto", "attitude_method": "attitude"},
             # the fixed DD carrier: ambiguity method, signals, elevation mask and ratio threshold of simkit.attitude
             "kf15_dd": {**COMMON, **FILTER, "align": "auto", "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
-                        "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6}}
+                        "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6, "dd_correlation_s": 30.0,
+                        "dd_correlation_window_s": 0.0}}
 CHOICES = {"gamma_rule": ("wu", "weighted"), "dd_method": ("lambda", "clambda", "mclambda"),
            "attitude_source": ("auto", "truth", "attitude"),
            "align": ("auto", "static", "motion", "truth", "attitude"),
@@ -68,6 +69,8 @@ def _check_value(key, default, value):
         raise EstimatorInputError(f"estimator.{key}: expected one of {', '.join(CHOICES[key])}, got {value!r}")
     if key == "dd_gate_p" and not 0 <= value < 1:
         raise EstimatorInputError(f"estimator.dd_gate_p: expected a probability in [0, 1), got {value!r}")
+    if key in ("dd_correlation_s", "dd_correlation_window_s") and not value >= 0:
+        raise EstimatorInputError(f"estimator.{key}: expected a number >= 0 (s; 0: off), got {value!r}")
     if key == "alpha" and not value > 1:
         raise EstimatorInputError(f"estimator.alpha: expected > 1 (Wu 2015 uses 10), got {value!r}")
 
@@ -314,8 +317,13 @@ def dd_carrier(ds, p) -> DDCarrier:
     n_ant = ds["gnss/antennas/lever_arm_b"].shape[0]
     if n_ant < 2:
         raise EstimatorInputError(f"{ds.path}: kf15_dd needs 2 or more antennas (one baseline), the file has {n_ant}")
+    window = float(p["dd_correlation_window_s"])
+    if window > 0:  # in samples of the GNSS interval
+        t = ds["gnss/t"][:2]
+        window = window / float(t[1] - t[0]) if t.size > 1 else 1.0
     fx = gnss_attitude.read_fixed_dd(ds, {"signals": p["dd_signals"], "mask_deg": p["dd_mask_deg"],
-                                          "ratio_threshold": p["dd_ratio_threshold"]}, p["dd_method"])
+                                          "ratio_threshold": p["dd_ratio_threshold"]}, p["dd_method"],
+                                     float(p["dd_correlation_s"]), window if window > 0 else np.inf)
     return DDCarrier(fx.t, fx.offsets, fx.los_enu, fx.baseline_b, fx.range_m, fx.cov)
 
 
