@@ -238,12 +238,12 @@ def test_time_correlated_dd_noise_inflates_only_the_multipath_part(xian):
 @pytest.mark.slow
 def test_kf15_dd_attitude_nees_on_a_static_site_is_within_the_bounds_with_the_correlated_noise_model(tmp_path):
     """30 s Gauss-Markov carrier multipath on a static site: taken as white the DD update is optimistic (NEES
-    4.4, 64 % inside at 10 x 600 s); with the default dd_correlation_s = 30 the mean is inside the bounds."""
+    4.4, 64 % inside at 10 x 600 s); with dd_correlation_s = 30 the mean is inside the bounds."""
     from simkit.estimators.dd_studies import attitude_nees
 
-    res = attitude_nees("xian_static_bds", runs=6, seconds=300.0, skip_s=60.0, workdir=tmp_path)
-    off = attitude_nees("xian_static_bds", runs=6, seconds=300.0, skip_s=60.0, workdir=tmp_path,
-                        params={"dd_correlation_s": 0.0})
+    res = attitude_nees("xian_static_bds", runs=6, seconds=300.0, skip_s=60.0, workdir=tmp_path,
+                        params={"dd_correlation_s": 30.0})
+    off = attitude_nees("xian_static_bds", runs=6, seconds=300.0, skip_s=60.0, workdir=tmp_path)
     lo, hi = res["bounds_95"]
     assert lo < res["nees_mean"] < hi and res["fraction_inside"] > 0.75, res
     assert off["nees_mean"] > res["nees_mean"] + 0.8, off
