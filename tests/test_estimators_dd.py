@@ -96,8 +96,8 @@ def test_lli_flags_and_rejected_fixes_keep_rows_out(xian):
         fd = read(ds, p)
     F = body_baselines(fd.lever_arm)
     grp = float_solution(fd.obs, np.radians(p["mask_deg"]))[0]
-    grp = type(grp)(*(getattr(grp, f)[:5] if f not in ("signal", "sat", "ref") else getattr(grp, f)
-                      for f in grp.__dataclass_fields__))
+    grp = type(grp)(*(getattr(grp, f)[:5] if f not in ("signal", "sat", "ref") and getattr(grp, f) is not None
+                      else getattr(grp, f) for f in grp.__dataclass_fields__))
     res = resolve(grp, "lambda", F)
     fd.lli[:] = 0  # start from no flags (the first epochs carry the receiver's initial-lock flags)
     full = group_rows(fd, grp, res, F)

@@ -31,7 +31,8 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
             "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.5,
                      "lever_arm_error_m": [0.0, 0.0, 0.0], "attitude_source": "auto", "attitude_method": "attitude"},
             # the fixed DD carrier: ambiguity method, signals, elevation mask and ratio threshold of simkit.attitude
-            "kf15_dd": {**COMMON, **FILTER, "align": "auto", "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
+            "kf15_dd": {**COMMON, **FILTER, "align": "auto",
+                        "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
                         "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6, "dd_correlation_s": 0.0,
                         "dd_correlation_window_s": 0.0}}
 CHOICES = {"gamma_rule": ("wu", "weighted"), "dd_method": ("lambda", "clambda", "mclambda"),
