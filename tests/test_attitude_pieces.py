@@ -195,3 +195,117 @@ def test_partial_fixing_fixes_true_integer_combinations_and_shrinks_the_baseline
     assert np.mean(right) >= 0.9  # each subset was chosen with bootstrapped success rate >= 0.99
     for i in part:
         assert np.trace(res.Qb[i]) < np.trace(grp.Qb[i])
+
+
+def _stacked_gls(obs, epochs, static):
+    """Independent construction of the multi-epoch float: every epoch's DD carrier and code (simkit.gnss
+    differencing) stacked in one weighted least squares with the ambiguities common and the baseline per epoch
+    (or common, ``static``). Returns (a, Qa, b of the last epoch, Qb, Qba)."""
+    ref = differencing.reference_satellites(obs.elevation, np.ones(obs.elevation.shape, bool), obs.sat_ids)
+    n_e, lam = len(epochs), obs.wavelength[0]
+    nb = 6 if static else 6 * n_e
+    Hs, ys, Qs = [], [], []
+    for j, m in enumerate(epochs):
+        D, ant, sat = differencing.dd_operator(ref[m], np.ones(8, bool), 3)
+        e = obs.los[m]
+        G1 = -(e[sat] - e[ref[m][sat]])
+        Gk = np.zeros((len(sat), 6))
+        for k in (1, 2):
+            Gk[ant == k, 3 * (k - 1):3 * k] = G1[ant == k]
+        rn = len(sat)
+        Hphi, Hp = np.zeros((rn, nb + rn)), np.zeros((rn, nb + rn))
+        col = slice(0, 6) if static else slice(6 * j, 6 * j + 6)
+        Hphi[:, col], Hp[:, col] = Gk, Gk
+        Hphi[:, nb:] = lam * np.eye(rn)
+        Hs += [Hphi, Hp]
+        ys += [D @ (obs.carrier[0, m] * lam).ravel(), D @ obs.code[0, m].ravel()]
+        Qs += [(D * obs.var_carrier[0, m].ravel()) @ D.T, (D * obs.var_code[0, m].ravel()) @ D.T]
+    H, y = np.concatenate(Hs), np.concatenate(ys)
+    W = np.linalg.inv(np.block([[Q if i == j else np.zeros((len(Q), len(P))) for j, P in enumerate(Qs)]
+                                for i, Q in enumerate(Qs)]))
+    P = np.linalg.inv(H.T @ W @ H)
+    x = P @ H.T @ W @ y
+    b = slice(nb - 6, nb)
+    return x[nb:], P[nb:, nb:], x[b], P[b, b], P[b, nb:]
+
+
+@pytest.mark.parametrize("static", [False, True])
+def test_multi_epoch_float_equals_the_stacked_least_squares_and_resets_at_a_loss_of_lock(static):
+    rng = np.random.default_rng(9)
+    obs, _ = _obs(rng, attitude_from_euler(0.02, -0.01, 0.4).as_matrix(), m=7)
+    lli = np.zeros(obs.carrier.shape, np.uint8)
+    lli[0, 4, 2, 3] = 1  # antenna 2, satellite 3 at epoch 4: the window restarts there
+    (single,) = float_solution(obs)
+    (grp,) = float_solution(obs, epochs=3, static=static, lli=lli)
+    for last, window in ((2, [0, 1, 2]), (3, [1, 2, 3]), (4, [4]), (6, [4, 5, 6])):
+        a, Qa, b, Qb, Qba = _stacked_gls(obs, window, static)
+        assert np.allclose(grp.a_hat[last], a, atol=1e-6) and np.allclose(grp.Qa[last], Qa, rtol=1e-7, atol=1e-12)
+        assert np.allclose(grp.b_hat[last], b, atol=1e-8) and np.allclose(grp.Qb[last], Qb, rtol=1e-7, atol=1e-14)
+        assert np.allclose(grp.Qba[last], Qba, rtol=1e-7, atol=1e-13)
+    assert np.allclose(grp.a_hat[4], single.a_hat[4]) and np.allclose(grp.Qa[4], single.Qa[4])
+    # three epochs of (nearly) the same geometry: about a third of the single-epoch ambiguity variance
+    ratio = np.trace(grp.Qa[2]) / np.trace(single.Qa[2])
+    assert 0.3 < ratio < 0.36 if not static else ratio < 0.34
+
+
+def test_lever_arm_velocity_of_a_steady_turn_matches_the_closed_form():
+    """A body turning at w about up (ENU fixed, no Earth rate in the differenced form): the lever arm's mean
+    velocity over dt is the chord R(t1) l - R(t0) l over dt, of length 2 |l_h| sin(w dt / 2) / dt, and the
+    instantaneous rate form gives |w| |l_h| (Earth rate removed)."""
+    from simkit.attitude.lever import lever_velocity_differenced, lever_velocity_rate
+    from simkit.earth import OMEGA_E
+    w, dt, lever = 0.3, 0.5, np.array([1.0, 2.0, 3.0])
+    h0 = np.radians([10.0, 200.0])
+    R0 = attitude_from_euler(0 * h0, 0 * h0, h0).as_matrix()
+    R1 = attitude_from_euler(0 * h0, 0 * h0, h0 + w * dt).as_matrix()
+    E = np.broadcast_to(np.eye(3), (2, 3, 3))
+    v, cov = lever_velocity_differenced(R0, R1, E, E, lever, np.full(2, dt))
+    assert np.allclose(np.linalg.norm(v, axis=1), 2 * np.hypot(1, 2) * np.sin(w * dt / 2) / dt, rtol=1e-12)
+    assert np.allclose(v[:, 2], 0) and np.all(cov == 0)
+    lat = np.radians([34.2, 34.2])
+    w_ie = OMEGA_E * np.array([0.0, np.cos(lat[0]), np.sin(lat[0])])
+    w_ib = np.einsum("kji,j->ki", R0, w_ie) + np.array([0.0, 0.0, -w])  # heading clockwise: body rate -w about z
+    P = np.broadcast_to(np.eye(3) * 1e-6, (2, 3, 3))
+    vr, cr = lever_velocity_rate(R0, w_ib, lat, lever, P, np.broadcast_to(np.eye(3) * 1e-8, (2, 3, 3)))
+    assert np.allclose(np.linalg.norm(vr, axis=1), w * np.hypot(1, 2), rtol=1e-12)
+    mid = attitude_from_euler(0 * h0, 0 * h0, h0 + w * dt / 2).as_matrix()
+    vm, _ = lever_velocity_rate(mid, np.einsum("kji,j->ki", mid, w_ie) + [0, 0, -w], lat, lever)
+    assert np.allclose(vm * np.sin(w * dt / 2) / (w * dt / 2), v, atol=1e-12)  # chord vs arc at the midpoint
+    # covariance: |v| sd of attitude 1 mrad in the plane of v and the rate noise 1e-4 rad/s x |l x axis|
+    assert np.all(np.linalg.eigvalsh(cr) > 0)
+
+
+def test_weighted_atdop_is_the_attitude_sd_of_the_weighted_fit_through_the_baselines():
+    """Weighted ATDOP x s = the Euler sd of the carrier-only fit with the DD covariance Q, computed the other
+    way round: fixed baselines Qb = (G' Q^-1 G)^-1 of the DD rows, then phi_covariance and euler_covariance.
+    Unit weights (Q = s^2 I) give Wang's ATDOP."""
+    from simkit.attitude.wahba import euler_covariance
+    rng = np.random.default_rng(11)
+    R = attitude_from_euler(0.05, -0.03, 2.2).as_matrix()[None]
+    los, el = _sky(rng, 1, 8)
+    G1 = -(los[:, 1:] - los[:, :1])  # (1, 7, 3) against satellite 0
+    sig = 0.002 / np.sin(el[0])  # elevation-dependent undifferenced sd, m
+    D = np.zeros((14, 3 * 8))  # DD of antennas (0, 1, 2) x 8 satellites, baseline-major
+    for k in (1, 2):
+        for i in range(7):
+            for a, sa in ((k, 1), (0, -1)):
+                D[(k - 1) * 7 + i, a * 8 + i + 1] += sa
+                D[(k - 1) * 7 + i, a * 8] -= sa
+    Q = (D * np.tile(sig ** 2, 3)) @ D.T
+    Gb = np.kron(np.eye(2), G1[0])
+    Qb = np.linalg.inv(Gb.T @ np.linalg.solve(Q, Gb))[None]
+    sd = np.sqrt(np.diagonal(euler_covariance(R, phi_covariance(R, F, Qb)), axis1=1, axis2=2))
+    s = np.sqrt(np.mean(np.diag(Q)))
+    assert np.allclose(atdop(R, F, G1, Q[None]) * s, sd, rtol=1e-6)
+    assert np.allclose(atdop(R, F, G1, np.eye(14)[None] * 3e-6), atdop(R, F, G1), rtol=1e-9)
+    assert not np.allclose(atdop(R, F, G1, Q[None]), atdop(R, F, G1), rtol=0.05)
+
+
+def test_correlation_inflation_is_the_variance_of_the_mean_of_a_gauss_markov_sequence():
+    from simkit.attitude.tight import correlation_inflation
+    tau, dt, n = 30.0, 1.0, 40
+    rho = np.exp(-dt / tau)
+    C = rho ** np.abs(np.subtract.outer(np.arange(n), np.arange(n)))  # unit-variance AR(1) covariance
+    assert np.isclose(correlation_inflation(tau, dt, n), C.sum() / n, rtol=1e-12)  # n Var(mean) / sigma^2
+    assert np.isclose(correlation_inflation(tau, dt), (1 + rho) / (1 - rho), rtol=1e-12)
+    assert correlation_inflation(0.0, dt) == 1.0

@@ -11,6 +11,16 @@ code (the carrier carries a free ambiguity per row), the float ambiguities from 
 with G = I_r (x) G_1 (baseline-major rows) and Qphi, Qp = D diag(sigma^2) D' from the undifferenced variances
 (so the rows of different baselines that share antenna 0 are correlated, as they are). Epochs are grouped by
 their channel pattern (which satellites / references / signals); every group is solved in one batch.
+
+Several epochs (``epochs`` = N > 1): the ambiguities are constant over a window of the last N epochs of a run (a
+run: consecutive epochs of one channel pattern without a loss-of-lock flag on any antenna for a satellite or
+reference used; the window is shorter at the start of a run), the noise white in time. Kinematic (baseline per
+epoch): the window's ambiguities are the information-weighted mean of the single-epoch floats,
+Qa_w = (sum_k Qa_k^-1)^-1, a_w = Qa_w sum_k Qa_k^-1 a_k, and epoch j's baseline is conditioned on them,
+b_j = b_hat_j + Qba_j Qa_j^-1 (a_w - a_j), Qba_w = Qba_j Qa_j^-1 Qa_w,
+Qb_w = Qb_j - Qba_j Qa_j^-1 (Qa_j - Qa_w) Qa_j^-1 Qab_j (a Kalman update of epoch j's (b, a) by the other
+epochs' independent ambiguity information). Static (one baseline over the window): the joint (b, a) of every
+epoch combined the same way with its full covariance. Time-correlated errors (multipath) make both optimistic.
 """
 from __future__ import annotations
 
@@ -28,7 +38,9 @@ class Observations:
 
     ``carrier`` (G, M, A, S) cycles; ``code`` (G, M, A, S) m; ``var_carrier`` / ``var_code`` (G, M, A, S) m^2
     undifferenced variances; ``wavelength`` (G,) m; ``los`` (M, S, 3) unit lines of sight receiver -> satellite
-    in ENU; ``elevation`` (M, S) rad; ``sat_ids`` (S,) str (the system is the first letter).
+    in ENU; ``elevation`` (M, S) rad; ``sat_ids`` (S,) str (the system is the first letter);
+    ``var_carrier_correlated`` (G, M, A, S) m^2 the part of ``var_carrier`` that is correlated in time
+    (multipath), or None.
     """
 
     carrier: np.ndarray
@@ -39,13 +51,14 @@ class Observations:
     los: np.ndarray
     elevation: np.ndarray
     sat_ids: np.ndarray
+    var_carrier_correlated: np.ndarray | None = None
 
     def __post_init__(self):
         shape = np.shape(self.carrier)
         if len(shape) != 4:
             raise AttitudeInputError("carrier", f"shape {shape}; expected (G, M, A, S)")
-        for name in ("code", "var_carrier", "var_code"):
-            if np.shape(getattr(self, name)) != shape:
+        for name in ("code", "var_carrier", "var_code", "var_carrier_correlated"):
+            if getattr(self, name) is not None and np.shape(getattr(self, name)) != shape:
                 raise AttitudeInputError(name, f"shape {np.shape(getattr(self, name))}; expected {shape}")
         g, m, a, s = shape
         if a < 2:
@@ -62,7 +75,8 @@ class FloatGroup:
     ``epochs`` (K,) indices into the M epochs; ``signal``, ``sat``, ``ref`` (n,) of each channel; ``a_hat`` (K, r n)
     cycles (baseline-major); ``Qa`` (K, r n, r n) cycles^2; ``b_hat`` (K, 3 r) m ENU; ``Qb`` (K, 3 r, 3 r) m^2;
     ``Qba`` (K, 3 r, r n) m cycles; ``G`` (K, n, 3) DD geometry (m per m of baseline); ``Qphi`` (K, r n, r n)
-    DD carrier covariance m^2.
+    DD carrier covariance m^2; ``Qphi_correlated`` (K, r n, r n) its time-correlated part (from
+    ``Observations.var_carrier_correlated``, when asked for: ``float_solution(..., correlated=True)``), or None.
     """
 
     epochs: np.ndarray
@@ -76,6 +90,7 @@ class FloatGroup:
     Qba: np.ndarray
     G: np.ndarray
     Qphi: np.ndarray
+    Qphi_correlated: np.ndarray | None = None
 
 
 def channel_masks(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None) -> np.ndarray:
@@ -131,14 +146,69 @@ def _patterns(usable, ref):
     return groups
 
 
-def float_solution(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None) -> list[FloatGroup]:
-    """Float DD solutions of every epoch with at least 3 DD channels, grouped by channel pattern."""
+def float_solution(obs: Observations, mask_rad: float = 0.0, max_sats: int | None = None, epochs: int = 1,
+                   static: bool = False, lli: np.ndarray | None = None, correlated: bool = False) -> list[FloatGroup]:
+    """Float DD solutions of every epoch with at least 3 DD channels, grouped by channel pattern; with
+    ``epochs`` > 1 each over the window of the last ``epochs`` epochs (module docstring), ``static`` with one
+    baseline over the window, windows reset at a gap and at a loss-of-lock flag of ``lli`` (G, M, A, S);
+    ``correlated``: also the time-correlated part of the DD carrier covariance (``Qphi_correlated``)."""
+    if int(epochs) < 1:
+        raise AttitudeInputError("epochs", f"{epochs}; expected an integer >= 1")
     usable = channel_masks(obs, mask_rad, max_sats)
     ref = references(obs, usable)
-    return [_solve_group(obs, *grp) for grp in _patterns(usable, ref)]
+    groups = [_solve_group(obs, *grp, correlated=correlated) for grp in _patterns(usable, ref)]
+    if int(epochs) == 1:
+        return groups
+    return [multi_epoch(grp, run_breaks(grp, lli), int(epochs), static) for grp in groups]
 
 
-def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:
+def run_breaks(grp: FloatGroup, lli: np.ndarray | None) -> np.ndarray:
+    """(K,) bool: where a run of the group's epochs starts: the first epoch, after a gap, or at a loss-of-lock
+    flag (``lli`` (G, M, A, S) > 0; None: none) on any antenna for a satellite or reference used."""
+    e = grp.epochs
+    out = np.ones(len(e), bool)
+    out[1:] = np.diff(e) != 1
+    if lli is not None:
+        flags = lli[grp.signal[:, None], e[None, :]][:, :, :, np.concatenate([grp.sat, grp.ref])] > 0
+        out |= flags.any(axis=(0, 2, 3))
+    return out
+
+
+def _window_sum(x: np.ndarray, start: np.ndarray, n: int) -> np.ndarray:
+    """sum of x[j - l] for l = 0 .. n-1 with j - l >= start[j] (the run's first index), along axis 0."""
+    out = x.copy()
+    idx = np.arange(len(x))
+    for lag in range(1, min(n, len(x))):
+        ok = idx - lag >= start
+        out[ok] += x[idx[ok] - lag]
+    return out
+
+
+def multi_epoch(grp: FloatGroup, breaks: np.ndarray, n: int, static: bool = False) -> FloatGroup:
+    """The group's floats over windows of the last ``n`` epochs of each run (``breaks`` (K,) run starts)."""
+    start = np.maximum.accumulate(np.where(breaks, np.arange(len(breaks)), 0))
+    if static:
+        x = np.concatenate([grp.b_hat, grp.a_hat], 1)
+        P = np.block([[grp.Qb, grp.Qba], [np.swapaxes(grp.Qba, 1, 2), grp.Qa]])
+        info = np.linalg.inv(P)
+        P_w = np.linalg.inv(_window_sum(info, start, n))
+        x_w = np.einsum("kij,kj->ki", P_w, _window_sum(np.einsum("kij,kj->ki", info, x), start, n))
+        nb = grp.b_hat.shape[1]
+        P_w = 0.5 * (P_w + np.swapaxes(P_w, 1, 2))
+        return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, x_w[:, nb:], P_w[:, nb:, nb:], x_w[:, :nb],
+                          P_w[:, :nb, :nb], P_w[:, :nb, nb:], grp.G, grp.Qphi, grp.Qphi_correlated)
+    info = np.linalg.inv(grp.Qa)
+    Qa_w = np.linalg.inv(_window_sum(info, start, n))
+    Qa_w = 0.5 * (Qa_w + np.swapaxes(Qa_w, 1, 2))
+    a_w = np.einsum("kij,kj->ki", Qa_w, _window_sum(np.einsum("kij,kj->ki", info, grp.a_hat), start, n))
+    T = grp.Qba @ info  # Qba Qa^-1
+    b_w = grp.b_hat + np.einsum("kij,kj->ki", T, a_w - grp.a_hat)
+    Qb_w = grp.Qb - T @ (grp.Qa - Qa_w) @ np.swapaxes(T, 1, 2)
+    return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, a_w, Qa_w, b_w, 0.5 * (Qb_w + np.swapaxes(Qb_w, 1, 2)),
+                      T @ Qa_w, grp.G, grp.Qphi, grp.Qphi_correlated)
+
+
+def _solve_group(obs: Observations, epochs, signal, sat, ref, correlated: bool = False) -> FloatGroup:
     """Batch least squares of one channel pattern (see the module docstring)."""
     n_ant = obs.carrier.shape[2]
     r, n = n_ant - 1, len(sat)
@@ -155,6 +225,9 @@ def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:
     y_p = take(obs.code) @ D.T
     Qphi = np.einsum("ij,kj,lj->kil", D, take(obs.var_carrier), D, optimize=True)
     Qp = np.einsum("ij,kj,lj->kil", D, take(obs.var_code), D, optimize=True)
+    Qc = None
+    if correlated and obs.var_carrier_correlated is not None:
+        Qc = np.einsum("ij,kj,lj->kil", D, take(obs.var_carrier_correlated), D, optimize=True)
     e = obs.los[epochs]
     G1 = -(e[:, sat, :] - e[:, ref, :])  # (K, n, 3)
     G = np.zeros((len(epochs), r * n, 3 * r))
@@ -169,4 +242,4 @@ def _solve_group(obs: Observations, epochs, signal, sat, ref) -> FloatGroup:
     Qa = (Qphi + GQb @ np.swapaxes(G, 1, 2)) / np.outer(lam, lam)
     Qa = 0.5 * (Qa + np.swapaxes(Qa, 1, 2))
     Qba = -np.swapaxes(GQb, 1, 2) / lam
-    return FloatGroup(epochs, signal, sat, ref, a_hat, Qa, b_hat, Qb, Qba, G1, Qphi)
+    return FloatGroup(epochs, signal, sat, ref, a_hat, Qa, b_hat, Qb, Qba, G1, Qphi, Qc)

@@ -25,6 +25,9 @@ AMBIGUITY_DEFAULTS = {
     "start_s": 0.0,               # first epoch solved (s since start)
     "stop_s": float("inf"),       # last epoch solved (s since start)
     "every": 1,                   # solve every n-th epoch only (1: all)
+    "float_epochs": 1,            # float solution over the last n epochs (ambiguities constant, reset at LLI /
+                                  # satellite set change); 1: single epoch
+    "static": 0,                  # 1: one baseline over the float window (static site); 0: a baseline per epoch
     "continuity": 1,              # 1: keep an accepted fix until a loss-of-lock flag or gap (not with every > 1);
                                   # 0: every epoch on its own (single-epoch resolution)
 }
@@ -39,6 +42,9 @@ TDCP_DEFAULTS = {
     "stop_s": float("inf"),
     "every": 1,                   # difference every n-th epoch with the one before it
     "troposphere": 1,             # 1: remove the modelled troposphere change (Saastamoinen, at the code position)
+    "lever_attitude": "auto",     # attitude for the IMU-centre velocity: attitude (solver), truth, none; auto:
+                                  # the solver with 3+ antennas, else none
+    "lever_rate": "attitude",     # turn of the lever arm from the attitude at both ends ("attitude") or the IMU gyro
 }
 
 

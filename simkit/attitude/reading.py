@@ -44,11 +44,13 @@ def _signals(ds, wanted: str) -> tuple:
 
 
 def _variances(cn0, el, wavelength, chip, p):
-    """Undifferenced carrier and code variances (m^2): C/N0 thermal jitter plus the elevation multipath profile."""
+    """Undifferenced carrier and code variances (m^2): C/N0 thermal jitter plus the elevation multipath profile;
+    and the carrier multipath part alone (the time-correlated one)."""
     mp = np.exp(-el / np.radians(p["multipath_elevation_deg"]))
     vc = pll_sigma_m(cn0, wavelength, p["pll_bandwidth_hz"], p["integration_time_s"]) ** 2
     vp = dll_sigma_m(cn0, chip, p["dll_bandwidth_hz"], p["correlator_spacing_chips"], p["integration_time_s"]) ** 2
-    return vc + (p["carrier_multipath_m"] * mp) ** 2, vp + (p["code_multipath_m"] * mp) ** 2
+    vm = (p["carrier_multipath_m"] * mp) ** 2
+    return vc + vm, vp + (p["code_multipath_m"] * mp) ** 2, vm + 0.0 * vc
 
 
 def read(ds, p: dict) -> FileData:
@@ -76,7 +78,7 @@ def read(ds, p: dict) -> FileData:
            for g, s in zip(names, sigs)]
     obs = Observations(np.stack([ds[f"gnss/obs/{g}/carrier"][sl] for g in names]), code,
                        np.stack([v[0] for v in var]), np.stack([v[1] for v in var]), lam, los, el,
-                       ds["gnss/sat_id"][:])
+                       ds["gnss/sat_id"][:], np.stack([v[2] for v in var]))
     amb = np.stack([ds[f"gnss/obs/{g}/ambiguity"][sl] for g in names])
     lli = np.stack([ds[f"gnss/obs/{g}/lli"][sl] for g in names])
     return FileData(t_all[sl], obs, amb, lli, ds["gnss/antennas/lever_arm_b"][:], names, receiver, sat_pos,

@@ -133,7 +133,8 @@ def _partial(grp, p0, accepted, partial, b, Qb, z_check, Zs):
 def subset(grp: FloatGroup, idx: np.ndarray) -> FloatGroup:
     """The epochs ``idx`` (indices into the group) of ``grp``."""
     return FloatGroup(grp.epochs[idx], grp.signal, grp.sat, grp.ref, *(getattr(grp, f)[idx] for f in
-                      ("a_hat", "Qa", "b_hat", "Qb", "Qba", "G", "Qphi")))
+                      ("a_hat", "Qa", "b_hat", "Qb", "Qba", "G", "Qphi")),
+                      None if grp.Qphi_correlated is None else grp.Qphi_correlated[idx])
 
 
 def _first_fixes(grp, breaks, method, F, kw):

@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 from ..frames import euler_from_attitude
 from ..solution import Solution
 from . import wahba
-from .dd import FloatGroup, dd_operator, float_solution
+from .dd import FloatGroup, dd_operator, float_solution, run_breaks
 from .errors import AttitudeInputError
 from .params import AMBIGUITY_DEFAULTS, merge
 from .reading import FileData, read
@@ -44,11 +44,7 @@ def _wrong(grp: FloatGroup, res: Resolution, fd: FileData) -> np.ndarray:
 def continuity_breaks(grp: FloatGroup, lli: np.ndarray) -> np.ndarray:
     """(K,) bool: the group's epochs where ambiguity continuity breaks: the first, after a gap in the epochs, or
     with a loss-of-lock flag (``lli`` (G, M, A, S) > 0) on any antenna for a satellite or reference used."""
-    e = grp.epochs
-    gap = np.ones(len(e), bool)
-    gap[1:] = np.diff(e) != 1
-    flags = lli[grp.signal[:, None], e[None, :]][:, :, :, np.concatenate([grp.sat, grp.ref])] > 0  # (n, K, A, 2n)
-    return gap | flags.any(axis=(0, 2, 3))
+    return run_breaks(grp, lli)
 
 
 def _attitude(res: Resolution, F: np.ndarray, method: str, kind: str):
@@ -85,6 +81,7 @@ def _empty(M: int, r: int, g: int, s: int, names) -> dict:
             "dd_ambiguity_true": np.full((M, r, g, s), nan), "reference_sat": np.full((M, g, s), -1, np.int16),
             "baseline_enu": np.full((M, r, 3), nan), "baseline_body": np.full((M, r, 3), nan),
             "baseline_float_enu": np.full((M, r, 3), nan), "atdop": np.full((M, 3), nan),
+            "atdop_weighted": np.full((M, 3), nan),
             "sigma_dd_carrier": np.full(M, nan)}
 
 
@@ -119,7 +116,8 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
     single = p["attitude"] == "baseline" or F.shape[1] == 1
     names = ("pitch", "heading") if single else ("pitch", "roll", "heading")
     out = _empty(M, a - 1, g, s, names)
-    groups = float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None)
+    groups = float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None, p["float_epochs"],
+                            bool(p["static"]), fd.lli)
     for grp in _progress(groups, progress, f"attitude ({method})"):
         kw = dict(ratio_threshold=p["ratio_threshold"], partial_p0=p["partial_p0"] or None,
                   max_nodes=int(p["max_nodes"]))
@@ -131,6 +129,7 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
         _store(out, grp, res, fd, R, cov)
         if not single:
             out["atdop"][grp.epochs] = wahba.atdop(R, F, grp.G)
+            out["atdop_weighted"][grp.epochs] = wahba.atdop(R, F, grp.G, grp.Qphi)
     if single:
         out["euler"][:, 1] = np.nan
     return out, names
@@ -140,7 +139,8 @@ _UNITS = {"status": "-1 none, 0 float, 1 fixed, 2 partial, 3 wrong fix", "ratio"
           "success_rate": "1",
           "n_sats": "1", "dd_ambiguity": "cycles", "dd_ambiguity_true": "cycles",
           "reference_sat": "index into /gnss/sat_id", "baseline_enu": "m", "baseline_body": "m",
-          "baseline_float_enu": "m", "atdop": "rad/m", "sigma_dd_carrier": "m"}
+          "baseline_float_enu": "m", "atdop": "rad/m", "atdop_weighted": "rad/m (x sigma_dd_carrier: the weighted "
+          "fit's sd)", "sigma_dd_carrier": "m"}
 
 
 def solver(name: str):
@@ -169,7 +169,5 @@ def solver(name: str):
 
 
 def build_registry() -> dict:
-    from .tdcp import solve_tdcp
-    reg = {name: solver(name) for name in _METHOD}
-    reg["tdcp"] = solve_tdcp
-    return reg
+    """The carrier-phase attitude solvers by name (``simkit.attitude.SOLVERS`` adds ``tdcp``)."""
+    return {name: solver(name) for name in _METHOD}

@@ -15,13 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..frames import ecef_to_enu_matrix, ecef_to_lla
-from ..gnss.atmosphere import troposphere
-from ..solution import Solution
-from .errors import AttitudeInputError
 from .geometry import C_LIGHT, sagnac_rotate
-from .params import TDCP_DEFAULTS, merge
-from .reading import read
 
 
 def _lsq(H, z, w):
@@ -66,38 +60,3 @@ def tdcp_velocity(phase_m, usable, sat_pos, sat_clock, receiver, dt, sigma_m=0.0
     vel = dr / dt[:, None]
     vel[n < 5], clock[n < 5], rms[n < 5] = np.nan, np.nan, np.nan
     return vel, clock / dt, w > 0, rms
-
-
-def solve_tdcp(ds, params: dict | None = None, progress: bool = False) -> Solution:
-    """TDCP velocity of antenna ``antenna`` from the file (see docs/attitude.md)."""
-    p = merge(TDCP_DEFAULTS, params, "tdcp")
-    read_p = {**p, "pll_bandwidth_hz": 15.0, "dll_bandwidth_hz": 1.0, "correlator_spacing_chips": 0.5,
-              "integration_time_s": 0.02, "carrier_multipath_m": 0.0, "code_multipath_m": 0.0,
-              "multipath_elevation_deg": 20.0}
-    fd = read(ds, read_p)
-    g, m, a, s = fd.obs.carrier.shape
-    ant = p["antenna"]
-    if not 0 <= ant < a:
-        raise AttitudeInputError("estimator.antenna", f"{ant}; expected 0 .. {a - 1}")
-    if m < 2:
-        raise AttitudeInputError("gnss/t", f"{m} epoch(s); TDCP needs at least 2")
-    phase = (fd.obs.carrier[:, :, ant] * fd.obs.wavelength[:, None, None]).transpose(1, 0, 2).reshape(m, -1)
-    up = fd.obs.elevation >= np.radians(p["mask_deg"])
-    ok = np.isfinite(phase) & np.tile(up, (1, g))
-    lli = (fd.lli[:, :, ant] > 0).transpose(1, 0, 2).reshape(m, -1)
-    usable = ok[1:] & ok[:-1] & ~lli[1:]
-    sat_pos, sat_clock = np.tile(fd.sat_pos, (1, g, 1)), np.tile(fd.sat_clock, (1, g))
-    receiver = fd.receiver
-    dt = np.diff(fd.t)
-    lla = ecef_to_lla(receiver)
-    tropo = troposphere(lla[:, 0:1], lla[:, 2:3], np.tile(np.maximum(fd.obs.elevation, 0.05), (1, g)))
-    vel, drift, used, rms = tdcp_velocity(phase, usable, sat_pos, sat_clock, receiver, dt, p["carrier_sigma_m"],
-                                          p["slip_threshold"], delay_m=tropo if p["troposphere"] else None)
-    lla = lla[:-1]
-    vel_enu = np.einsum("kij,kj->ki", ecef_to_enu_matrix(lla[:, 0], lla[:, 1]), vel)
-    extras = {"vel_enu_antenna": vel_enu, "clock_drift": drift, "n_used": used.sum(1).astype(np.int16),
-              "n_rejected": (usable & ~used).sum(1).astype(np.int16), "residual_rms": rms}
-    units = {"vel_enu_antenna": "m/s", "clock_drift": "m/s", "n_used": "1", "n_rejected": "1", "residual_rms": "m"}
-    config = {"estimator": "tdcp", "signals": list(fd.signals), **p}
-    config["stop_s"] = None if np.isinf(p["stop_s"]) else p["stop_s"]
-    return Solution(t=0.5 * (fd.t[1:] + fd.t[:-1]), extras=extras, extra_units=units, config=config)

@@ -63,8 +63,24 @@ def _dd_phase(fd: FileData, grp: FloatGroup) -> np.ndarray:
     return (dd * lam).transpose(0, 2, 1).reshape(K, r * n), flag.transpose(0, 2, 1).reshape(K, r * n)
 
 
-def group_rows(fd: FileData, grp: FloatGroup, res: Resolution, F: np.ndarray) -> list:
-    """[(epoch, G rows (m, 3), f rows (m, 3), y (m,), R (m, m), wrong)] of the group's usable epochs."""
+def correlation_inflation(correlation_s: float, interval_s: float, window: float = np.inf) -> float:
+    """Variance factor of the time-correlated DD noise for a filter that takes it as white: a first-order
+    Gauss-Markov error of correlation time ``correlation_s`` sampled every ``interval_s`` (rho = exp(-dt/tau))
+    averaged over ``window`` samples has the variance of the mean sigma^2 f / n with
+    f = 1 + 2 sum_{k=1}^{n-1} (1 - k/n) rho^k, -> (1 + rho) / (1 - rho) for a long window: the white-noise
+    variance that gives the same information. 1 when ``correlation_s`` <= 0 (white)."""
+    if not correlation_s > 0:
+        return 1.0
+    rho = np.exp(-interval_s / correlation_s)
+    if not np.isfinite(window):
+        return float((1 + rho) / (1 - rho))
+    k = np.arange(1, max(int(window), 1))
+    return float(1 + 2 * np.sum((1 - k / window) * rho ** k))
+
+
+def group_rows(fd: FileData, grp: FloatGroup, res: Resolution, F: np.ndarray, inflation: float = 1.0) -> list:
+    """[(epoch, G rows (m, 3), f rows (m, 3), y (m,), R (m, m), wrong)] of the group's usable epochs; R is the DD
+    carrier covariance with its time-correlated part (``grp.Qphi_correlated``) times ``inflation``."""
     n, r = len(grp.sat), F.shape[1]
     phase, flag = _dd_phase(fd, grp)
     lam = np.tile(fd.obs.wavelength[grp.signal], r)
@@ -73,28 +89,34 @@ def group_rows(fd: FileData, grp: FloatGroup, res: Resolution, F: np.ndarray) ->
     G = np.tile(grp.G, (1, r, 1))
     f = np.repeat(F.T, n, axis=0)
     wrong, _ = _wrong(grp, res, fd)
+    Q = grp.Qphi if inflation == 1.0 else grp.Qphi + (inflation - 1.0) * grp.Qphi_correlated
     out = []
     for i in np.flatnonzero(keep.any(1)):
         k = keep[i]
-        out.append((grp.epochs[i], G[i, k], f[k], y[i, k], grp.Qphi[i][np.ix_(k, k)], wrong[i],
+        out.append((grp.epochs[i], G[i, k], f[k], y[i, k], Q[i][np.ix_(k, k)], wrong[i],
                     int((res.accepted[i] & flag[i]).sum())))
     return out
 
 
-def fixed_dd(fd: FileData, method: str, p: dict) -> FixedDD:
+def fixed_dd(fd: FileData, method: str, p: dict, correlation_s: float = 0.0, window: float = np.inf) -> FixedDD:
     """The fixed DD carrier of every epoch of ``fd`` with ``method`` (lambda, clambda, mclambda) and the
-    ambiguity parameters ``p`` (``simkit.attitude.params.AMBIGUITY_DEFAULTS``)."""
+    ambiguity parameters ``p`` (``simkit.attitude.params.AMBIGUITY_DEFAULTS``); with ``correlation_s`` > 0 the
+    multipath part of the covariance is inflated by :func:`correlation_inflation` (epoch interval from ``fd.t``,
+    ``window`` samples)."""
     if method not in METHODS:
         raise AttitudeInputError("method", f"{method!r}; expected one of {', '.join(METHODS)}")
     F = body_baselines(fd.lever_arm)
     kw = dict(ratio_threshold=p["ratio_threshold"], partial_p0=None, max_nodes=int(p["max_nodes"]))
     rows = []
-    for grp in float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None):
+    interval = float(np.median(np.diff(fd.t))) if len(fd.t) > 1 else 1.0
+    inflation = correlation_inflation(correlation_s, interval, window)
+    for grp in float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None, p["float_epochs"],
+                              bool(p["static"]), fd.lli, correlated=inflation != 1.0):
         if p["continuity"] and p["every"] == 1:
             res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), **kw)
         else:
             res = resolve(grp, method, F, **kw)
-        rows += group_rows(fd, grp, res, F)
+        rows += group_rows(fd, grp, res, F, inflation)
     rows.sort(key=lambda row: row[0])
     return _pack(fd, rows)
 
@@ -108,9 +130,10 @@ def _pack(fd: FileData, rows: list) -> FixedDD:
                    cat(3, ()), cov, np.array([row[5] for row in rows], bool), int(sum(row[6] for row in rows)))
 
 
-def read_fixed_dd(ds, params: dict | None = None, method: str = "lambda") -> FixedDD:
+def read_fixed_dd(ds, params: dict | None = None, method: str = "lambda", correlation_s: float = 0.0,
+                  window: float = np.inf) -> FixedDD:
     """:func:`fixed_dd` of a simkit file (``simkit.io.Dataset``); ``params`` override the ambiguity defaults."""
     from .params import AMBIGUITY_DEFAULTS, merge
     from .reading import read
     p = merge(AMBIGUITY_DEFAULTS, params, "kf15_dd")
-    return fixed_dd(read(ds, p), method, p)
+    return fixed_dd(read(ds, p), method, p, correlation_s, window)

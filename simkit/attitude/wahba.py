@@ -11,6 +11,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..frames import euler_from_attitude
+from ..validation import atdop as validation_atdop
 
 
 def skew(v: np.ndarray) -> np.ndarray:
@@ -95,14 +96,22 @@ def single_baseline(b: np.ndarray, Qb: np.ndarray, f: np.ndarray):
     return pitch, heading, J @ Qb @ np.swapaxes(J, 1, 2)
 
 
-def atdop(R: np.ndarray, F: np.ndarray, G: np.ndarray) -> np.ndarray:
+def atdop(R: np.ndarray, F: np.ndarray, G: np.ndarray, Q: np.ndarray | None = None) -> np.ndarray:
     """ATDOP (K, 3) [pitch, roll, heading] rad per metre of DD carrier noise: sqrt(diag(J L^-1 J')) with the
-    Gramian L = H' H of the DD carrier rows H = G [-(R f_k) x] (unit weights; Wang 2018 eqs 8, 10-12, 16).
-    ``G`` (K, n, 3) DD geometry of one baseline's channels (the same for every baseline)."""
+    Gramian L = H' H of the DD carrier rows H = G [-(R f_k) x] (unit weights; Wang 2018 eqs 8, 10-12, 16),
+    through :func:`simkit.validation.atdop` of the Gramian in Euler coordinates, (J L^-1 J')^-1.
+    ``G`` (K, n, 3) DD geometry of one baseline's channels (the same for every baseline). With ``Q`` (K, r n,
+    r n) the DD carrier covariance (m^2), the weighted ATDOP: L = H' (Q / s^2)^-1 H with s^2 the mean diagonal
+    of Q, so that ATDOP x s is the attitude sd of the weighted fit (elevation weighting and DD correlations
+    included) and the unit-weight ATDOP is the case Q = s^2 I."""
     H = np.concatenate([G @ -skew(np.einsum("kij,j->ki", R, F[:, k])) for k in range(F.shape[1])], axis=1)
-    J = euler_jacobian(R)
-    P = J @ np.linalg.inv(np.swapaxes(H, 1, 2) @ H) @ np.swapaxes(J, 1, 2)
-    return np.sqrt(np.diagonal(P, axis1=1, axis2=2))
+    if Q is None:
+        L = np.swapaxes(H, 1, 2) @ H
+    else:
+        s2 = np.mean(np.diagonal(Q, axis1=1, axis2=2), axis=1)[:, None, None]
+        L = np.swapaxes(H, 1, 2) @ np.linalg.solve(Q / s2, H)
+    Ji = np.linalg.inv(euler_jacobian(R))
+    return validation_atdop(np.swapaxes(Ji, 1, 2) @ L @ Ji)
 
 
 def wahba_wls(b: np.ndarray, F: np.ndarray, Qb: np.ndarray, iterations: int = 3) -> np.ndarray:

@@ -31,11 +31,13 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
             "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.5,
                      "lever_arm_error_m": [0.0, 0.0, 0.0], "attitude_source": "auto", "attitude_method": "attitude"},
             # the fixed DD carrier: ambiguity method, signals, elevation mask and ratio threshold of simkit.attitude
-            "kf15_dd": {**COMMON, **FILTER, "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
-                        "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6}}
+            "kf15_dd": {**COMMON, **FILTER, "align": "auto",
+                        "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
+                        "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6, "dd_correlation_s": 0.0,
+                        "dd_correlation_window_s": 0.0}}
 CHOICES = {"gamma_rule": ("wu", "weighted"), "dd_method": ("lambda", "clambda", "mclambda"),
            "attitude_source": ("auto", "truth", "attitude"),
-           "align": ("static", "motion", "truth", "attitude"),
+           "align": ("auto", "static", "motion", "truth", "attitude"),
            "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
 
 
@@ -68,6 +70,8 @@ def _check_value(key, default, value):
         raise EstimatorInputError(f"estimator.{key}: expected one of {', '.join(CHOICES[key])}, got {value!r}")
     if key == "dd_gate_p" and not 0 <= value < 1:
         raise EstimatorInputError(f"estimator.dd_gate_p: expected a probability in [0, 1), got {value!r}")
+    if key in ("dd_correlation_s", "dd_correlation_window_s") and not value >= 0:
+        raise EstimatorInputError(f"estimator.{key}: expected a number >= 0 (s; 0: off), got {value!r}")
     if key == "alpha" and not value > 1:
         raise EstimatorInputError(f"estimator.alpha: expected > 1 (Wu 2015 uses 10), got {value!r}")
 
@@ -189,13 +193,14 @@ def filter_config(ds, p, name) -> FilterConfig:
         gamma_rule=str(p.get("gamma_rule", "wu")), dd_gate_p=float(p.get("dd_gate_p", 0.0)))
 
 
-def _attitude_alignment(ds, p, gnss: GnssFixes, good):
-    """([pitch, roll, heading] rad, GNSS fix index): the first fixed epoch of the attitude solver that has a
-    GNSS fix at the same time."""
+def _attitude_alignment(ds, p, gnss: GnssFixes, good, stop_s: float | None = None):
+    """([pitch, roll, heading] rad, GNSS fix index): the first fixed epoch of the attitude solver (epochs up to
+    ``stop_s`` s; None: all) that has a GNSS fix at the same time."""
     if ds["gnss/antennas/lever_arm_b"].shape[0] < 3:
         raise EstimatorInputError(f"estimator.align: 'attitude' needs 3 or more antennas, {ds.path} has "
                                   f"{ds['gnss/antennas/lever_arm_b'].shape[0]}")
-    att = _solved_attitude(ds, {"attitude_method": p.get("attitude_method", "attitude")})
+    att = _solved_attitude(ds, {"attitude_method": p.get("attitude_method", "attitude")},
+                           {} if stop_s is None else {"stop_s": float(stop_s)})
     both = np.flatnonzero(np.isin(np.round(gnss.t[good], 6), np.round(att.t, 6)))
     if both.size == 0:
         raise EstimatorInputError("estimator.align: 'attitude' found no epoch with fixed ambiguities and a GNSS fix")
@@ -203,11 +208,12 @@ def _attitude_alignment(ds, p, gnss: GnssFixes, good):
     return att.euler[np.argmin(np.abs(att.t - gnss.t[g0]))], g0
 
 
-def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
+def initial_state(ds, p, imu: ImuData, gnss: GnssFixes, found=None) -> InitialState:
     """Initial navigation state from ``p['align']``: 'static' (levelling + gyrocompassing over the first
     align_static_s; at the first IMU sample), 'motion' (from the first GNSS fix faster than 5 m/s, at its epoch),
     'attitude' (the multi-antenna carrier-phase attitude at its first fixed epoch, 3+ antennas; at that GNSS
-    fix), 'truth' (the file's truth at the first sample, a study mode), plus ``init_heading_error_deg``."""
+    fix; ``found`` an alignment :func:`resolve_align` already made), 'truth' (the file's truth at the first sample,
+    a study mode), plus ``init_heading_error_deg``."""
     good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
     if good.size == 0:
         raise EstimatorInputError(f"{ds.path}: no GNSS fix to initialise the position from")
@@ -216,7 +222,7 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
     if p["align"] == "truth":
         euler, lla, vel = ds["truth/euler"][0], ds["truth/pos_lla"][0], ds["truth/vel_enu"][0]
     elif p["align"] == "attitude":
-        euler, g0 = _attitude_alignment(ds, p, gnss, good)
+        euler, g0 = found if found is not None else _attitude_alignment(ds, p, gnss, good)
         vel, lla = gnss.vel_enu[g0], ecef_to_lla(gnss.pos_ecef[g0])
     elif p["align"] in ("static", "motion"):
         if p["align"] == "static":
@@ -241,6 +247,37 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes) -> InitialState:
     return InitialState(t0, np.asarray(lla, float), np.asarray(vel, float), quat_from_euler(*euler))
 
 
+AUTO_ATTITUDE_S = 300.0   # align = "auto" looks for a fixed attitude in the first 300 s only
+STATIC_SPEED_M_S = 0.5    # stationary start: every GNSS speed in the first align_static_s below this
+STATIC_FORCE_STD = 0.1    # and the IMU specific-force magnitude steadier than this (m/s^2, sd)
+
+
+def stationary_start(p, imu: ImuData, gnss: GnssFixes) -> bool:
+    """True when the first ``align_static_s`` look stationary: every GNSS velocity fix in it below
+    STATIC_SPEED_M_S (at least 2 fixes) and the specific-force magnitude's sd below STATIC_FORCE_STD."""
+    span = float(p["align_static_s"])
+    g = np.flatnonzero((gnss.t <= imu.t[0] + span) & np.isfinite(gnss.vel_enu).all(1))
+    n = max(2, int(np.searchsorted(imu.t, imu.t[0] + span)))
+    force = imu.accel[:n] if not imu.increments else imu.accel[1:n] / np.diff(imu.t[:n])[:, None]
+    return bool(g.size >= 2 and np.all(np.linalg.norm(gnss.vel_enu[g], axis=1) < STATIC_SPEED_M_S)
+                and np.std(np.linalg.norm(force, axis=1)) < STATIC_FORCE_STD)
+
+
+def resolve_align(ds, p, imu: ImuData, gnss: GnssFixes):
+    """(``p['align']`` with "auto" resolved, the attitude alignment found or None): "attitude" when the file has
+    3+ antennas and the attitude solver fixes an epoch with a GNSS fix in the first AUTO_ATTITUDE_S, else
+    "static" when the start is stationary (:func:`stationary_start`), else "motion"."""
+    if p["align"] != "auto":
+        return p["align"], None
+    good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
+    if ds["gnss/antennas/lever_arm_b"].shape[0] >= 3 and good.size:
+        try:
+            return "attitude", _attitude_alignment(ds, p, gnss, good, float(gnss.t[good[0]]) + AUTO_ATTITUDE_S)
+        except EstimatorInputError:
+            pass
+    return ("static" if stationary_start(p, imu, gnss) else "motion"), None
+
+
 def attitude_source(ds, p) -> str:
     """``p['attitude_source']`` with "auto" resolved: "attitude" when the file has 3 or more antennas, else
     "truth"; "attitude" with fewer than 3 antennas is an error naming the key."""
@@ -254,11 +291,11 @@ def attitude_source(ds, p) -> str:
     return src
 
 
-def _solved_attitude(ds, p) -> AttitudeFixes:
-    """GNSS attitude from the multi-antenna carrier-phase solver ``p['attitude_method']`` of simkit.attitude:
-    its Euler angles and their covariance at the epochs whose ambiguities are fixed and validated (status
-    fixed, or wrong fix: the filter cannot tell them apart)."""
-    sol = gnss_attitude.SOLVERS[p["attitude_method"]](ds, {})
+def _solved_attitude(ds, p, solver_params: dict | None = None) -> AttitudeFixes:
+    """GNSS attitude from the multi-antenna carrier-phase solver ``p['attitude_method']`` of simkit.attitude
+    (its defaults overridden by ``solver_params``): its Euler angles and their covariance at the epochs whose
+    ambiguities are fixed and validated (status fixed, or wrong fix: the filter cannot tell them apart)."""
+    sol = gnss_attitude.SOLVERS[p["attitude_method"]](ds, solver_params or {})
     ok = np.isin(sol.extras["status"], (1, 3)) & np.isfinite(sol.euler).all(1) & np.isfinite(sol.cov).all((1, 2))
     return AttitudeFixes(sol.t[ok], sol.euler[ok], sol.cov[ok])
 
@@ -281,8 +318,13 @@ def dd_carrier(ds, p) -> DDCarrier:
     n_ant = ds["gnss/antennas/lever_arm_b"].shape[0]
     if n_ant < 2:
         raise EstimatorInputError(f"{ds.path}: kf15_dd needs 2 or more antennas (one baseline), the file has {n_ant}")
+    window = float(p["dd_correlation_window_s"])
+    if window > 0:  # in samples of the GNSS interval
+        t = ds["gnss/t"][:2]
+        window = window / float(t[1] - t[0]) if t.size > 1 else 1.0
     fx = gnss_attitude.read_fixed_dd(ds, {"signals": p["dd_signals"], "mask_deg": p["dd_mask_deg"],
-                                          "ratio_threshold": p["dd_ratio_threshold"]}, p["dd_method"])
+                                          "ratio_threshold": p["dd_ratio_threshold"]}, p["dd_method"],
+                                     float(p["dd_correlation_s"]), window if window > 0 else np.inf)
     return DDCarrier(fx.t, fx.offsets, fx.los_enu, fx.baseline_b, fx.range_m, fx.cov)
 
 
@@ -292,11 +334,13 @@ def solve_filter(name):
     def solve(ds, params, progress=False) -> Solution:
         p = merged(name, params)
         imu, gnss = imu_data(ds), gnss_fixes(ds, p)
-        init = initial_state(ds, p, imu, gnss)
+        align, found = resolve_align(ds, p, imu, gnss)
+        init = initial_state(ds, {**p, "align": align}, imu, gnss, found)
         att = _attitude(ds, p) if name == "kf21" and p["use_attitude"] else None
         dd = dd_carrier(ds, p) if name == "kf15_dd" else None
         sol = cls(filter_config(ds, p, name), init).run(imu, gnss, att, dd=dd)
         extra = {"attitude_source": attitude_source(ds, p)} if name == "kf21" and p["use_attitude"] else {}
+        extra["align_used"] = align
         return Solution(**{**sol.__dict__, "config": {**sol.config, "params": p, **extra}})
 
     solve.__doc__ = f"simkit solve --filter {name}: {cls.__doc__.splitlines()[0]}"
