@@ -220,3 +220,23 @@ def ils_success_bounds(Q, max_nodes=1_000_000, rounds=0) -> dict:
     out["lower"] = np.fmax(out["bootstrap"], out["pullin_lower"])
     out["upper"] = np.fmin(out["pullin_upper"], out["adop_upper"])
     return {k: _out(v, single) for k, v in out.items()}
+
+
+def monte_carlo_success_rates(Q, n_samples, rng, chunk=50_000):
+    """Monte Carlo ILS success rate of each covariance of a stack ``Q`` (K, n, n) (cycles^2): ``n_samples`` draws
+    a_hat ~ N(0, Q_k) each, solved in batches of about ``chunk`` problems. Returns (rates (K,), standard errors
+    (K,)); ``rng`` a seeded ``numpy.random.Generator`` (draws in epoch order: deterministic)."""
+    from .search import ils_batch
+
+    Qs, _ = _as_stack(Q)
+    K, n = Qs.shape[:2]
+    N = int(n_samples)
+    ok = np.zeros(K)
+    L = np.linalg.cholesky(Qs)
+    step = max(1, chunk // N)
+    for s in range(0, K, step):
+        k = slice(s, min(s + step, K))
+        e = np.einsum("kij,ksj->ksi", L[k], rng.standard_normal((L[k].shape[0], N, n)))
+        res = ils_batch(e.reshape(-1, n), np.repeat(Qs[k], N, axis=0), n_cands=1)
+        ok[k] = np.all(res.candidates[:, 0, :] == 0, axis=1).reshape(-1, N).mean(axis=1)
+    return ok, np.sqrt(np.maximum(ok * (1.0 - ok), 1e-300) / N)
