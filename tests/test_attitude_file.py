@@ -84,3 +84,22 @@ def test_single_epoch_lambda_rates_agree_with_the_predicted_success_rate(tmp_pat
         width = (hi - lo) * 2.58 / 1.96 / 2
         assert r["fix_rate"] - width <= r["ils_sr_mc"] <= r["fix_rate"] + width, r
         assert r["bootstrap_sr"] <= r["fix_rate"] + width, r
+        assert r["ils_lower"] - width <= r["fix_rate"] <= r["ils_upper"] + width, r  # pull-in bounds bracket it
+
+
+def test_ffrt_holds_the_failure_rate_and_fixes_more_than_a_strict_ratio(xian):
+    """Single epoch, 8 satellites: the fixed-failure-rate test (Pf = 0.01, calibrated per epoch) keeps the
+    wrong-fix rate at or below Pf within its binomial 95 % interval and fixes more epochs than the fixed ratio 3."""
+    from scipy.stats import binomtest
+
+    ds = simkit.open(xian)
+    base = {"continuity": 0, "max_sats": 8, "every": 3}
+    ff = SOLVERS["attitude"](ds, {**base, "validation": "ffrt", "pf": 0.01, "ffrt_samples": 2000}, False)
+    rt = SOLVERS["attitude"](ds, {**base, "ratio_threshold": 3.0}, False)
+    st_f, st_r = ff.extras["status"], rt.extras["status"]
+    n = int((st_f >= 0).sum())
+    wrong = int((st_f == 3).sum())
+    assert binomtest(wrong, n).proportion_ci(0.95).low <= 0.01
+    assert (st_f == 1).sum() > (st_r == 1).sum()
+    with pytest.raises(AttitudeInputError, match="estimator.validation"):
+        SOLVERS["attitude_c"](ds, {"validation": "ffrt"}, False)

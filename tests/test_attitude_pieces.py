@@ -309,3 +309,27 @@ def test_correlation_inflation_is_the_variance_of_the_mean_of_a_gauss_markov_seq
     assert np.isclose(correlation_inflation(tau, dt, n), C.sum() / n, rtol=1e-12)  # n Var(mean) / sigma^2
     assert np.isclose(correlation_inflation(tau, dt), (1 + rho) / (1 - rho), rtol=1e-12)
     assert correlation_inflation(0.0, dt) == 1.0
+
+
+def test_ffrt_validation_bounds_and_options():
+    """validation=ffrt: each epoch's mu equals the stand-alone calibration of its own Qa (same seed), epochs
+    accepted exactly where best / 2nd <= mu; the success-rate bounds bracket the bootstrapped rate; ffrt is
+    refused for the constrained solvers and unknown validations are named."""
+    rng = np.random.default_rng(9)
+    obs, _ = _obs(rng, attitude_from_euler(0.0, 0.0, 0.4).as_matrix(), m=8, s=5, sig_phi=0.003, sig_p=0.3)
+    (grp,) = float_solution(obs)
+    res = resolve(grp, "lambda", F, validation="ffrt", pf=0.01, ffrt_samples=2000)
+    assert np.all(res.sr_bounds[:, 0] <= res.sr_bounds[:, 1] + 1e-12)
+    assert np.all(res.sr_bounds[:, 0] >= res.success_rate - 1e-12)
+    assert np.all((res.mu > 0) & (res.mu <= 1))
+    need = ~(1.0 - res.sr_bounds[:, 0] <= 0.01)
+    assert need.any()
+    mu = amb.ffrt_thresholds(grp.Qa[need], 0.01, 2000, seed=len(grp.Qa))
+    assert np.array_equal(res.mu[need], mu)
+    assert np.array_equal(res.accepted, res.finished & (1.0 / res.ratio <= res.mu))
+    none = resolve(grp, "lambda", F, validation="none")
+    assert none.accepted.all() and np.isnan(none.mu).all()
+    with pytest.raises(AttitudeInputError, match="estimator.validation"):
+        resolve(grp, "clambda", F, validation="ffrt")
+    with pytest.raises(AttitudeInputError, match="estimator.validation"):
+        resolve(grp, "lambda", F, validation="strict")

@@ -101,3 +101,27 @@ def partial_fix(a_hat, Q, p0=0.995, n_cands=2) -> PartialFix:
     a_c = a - gain @ (Zp.T.astype(float) @ a - zfix)
     Q_c = Qm - gain @ QZ.T
     return PartialFix(n - k, ps, Zp, zfix, res.sqnorms, a_c, 0.5 * (Q_c + Q_c.T))
+
+
+def ffrt_thresholds(Q, failure_rate=1e-3, n_samples=10_000, rng=None, seed=0, chunk=50_000):
+    """:func:`ffrt_threshold` for each covariance of a stack ``Q`` (K, n, n), the draws of all problems solved in
+    batches of about ``chunk``: (K,) mu (accept when sqnorm_best / sqnorm_2nd <= mu). Deterministic for a seed."""
+    Qs = np.asarray(Q, dtype=np.float64)
+    if Qs.ndim != 3:
+        raise AmbiguityInputError("Q", f"shape {Qs.shape}; expected (K, n, n)")
+    rng = np.random.default_rng(seed) if rng is None else rng
+    K, n = Qs.shape[:2]
+    N = int(n_samples)
+    allowed = int(math.floor(failure_rate * N))
+    mu = np.ones(K)
+    L = np.linalg.cholesky(Qs)
+    step = max(1, chunk // N)
+    for s in range(0, K, step):
+        k = slice(s, min(s + step, K))
+        e = np.einsum("kij,ksj->ksi", L[k], rng.standard_normal((L[k].shape[0], N, n)))
+        res = ils_batch(e.reshape(-1, n), np.repeat(Qs[k], N, axis=0), n_cands=2)
+        wrong = np.any(res.candidates[:, 0, :] != 0, axis=1)
+        ratio = np.where(wrong, res.sqnorms[:, 0] / res.sqnorms[:, 1], np.inf).reshape(-1, N)
+        cut = np.sort(ratio, axis=1)[:, allowed]  # the (allowed+1)-th failure; inf: too few failures
+        mu[k] = np.where(np.isfinite(cut), np.nextafter(cut, 0.0), 1.0)
+    return mu

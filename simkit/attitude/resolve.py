@@ -15,6 +15,7 @@ from .dd import FloatGroup
 from .errors import AttitudeInputError
 
 METHODS = ("lambda", "clambda", "mclambda")
+VALIDATIONS = ("ratio", "ffrt", "none")
 
 
 @dataclass(frozen=True)
@@ -27,7 +28,9 @@ class Resolution:
     search stopped once the ratio was known to pass, so ``ratio`` is a lower bound); ``b`` (K, 3 r) m ENU
     baselines given the fix (float where nothing was accepted); ``Qb`` (K, 3 r, 3 r) m^2; ``rotation`` (K, 3, 3) body -> ENU of
     MC-LAMBDA (NaN otherwise); ``z_check`` (K, p) the fixed combinations and ``Z`` (K, r n, p) the integer maps
-    (z_check = Z' a for the true a when right) used to label wrong fixes, p = r n for full fixes.
+    (z_check = Z' a for the true a when right) used to label wrong fixes, p = r n for full fixes;
+    ``sr_bounds`` (K, 2) lower and upper bounds of the ILS success rate (pull-in regions, bootstrapping, ADOP
+    volume); ``mu`` (K,) the fixed-failure-rate threshold on best / 2nd squared norm (NaN unless validation ffrt).
     """
 
     z: np.ndarray
@@ -42,6 +45,8 @@ class Resolution:
     z_check: list
     Z: list
     bounded: np.ndarray
+    sr_bounds: np.ndarray
+    mu: np.ndarray
 
 
 def conditioned(grp: FloatGroup, z: np.ndarray):
@@ -81,20 +86,34 @@ def _search(grp: FloatGroup, method: str, F: np.ndarray, max_nodes: int, stop: f
 
 
 def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float = 3.0, partial_p0=None,
-            max_nodes: int = amb.DEFAULT_MAX_NODES) -> Resolution:
+            max_nodes: int = amb.DEFAULT_MAX_NODES, validation: str = "ratio", pf: float = 1e-3,
+            ffrt_samples: int = 10_000) -> Resolution:
     """Fix the ambiguities of ``grp`` with ``method`` (one of :data:`METHODS`); ``F`` (3, r) body baselines m.
 
-    Accept when ratio >= ``ratio_threshold`` (0 accepts every finished search) and the search finished; with
+    ``validation`` "ratio": accept when ratio >= ``ratio_threshold`` (0 accepts every finished search); "none":
+    accept every finished search; "ffrt" (LAMBDA only): fixed-failure-rate ratio test, accept when best / 2nd <=
+    mu with mu calibrated per epoch on its own Qa for the failure rate ``pf`` (``ffrt_samples`` Monte Carlo
+    draws; mu = 1 without draws where the lower bound of the ILS success rate is already >= 1 - pf). With
     ``partial_p0`` (LAMBDA only) epochs that fail the test fix the largest decorrelated subset whose
     bootstrapped success rate is >= partial_p0.
     """
     if method not in METHODS:
         raise AttitudeInputError("method", f"{method!r}; expected one of {', '.join(METHODS)}")
-    stop = ratio_threshold if ratio_threshold > 0 else 1.0  # 1: stop once the best is proven
+    if validation not in VALIDATIONS or (validation == "ffrt" and method != "lambda"):
+        raise AttitudeInputError("estimator.validation", f"{validation!r}; expected ratio or none, or ffrt (LAMBDA: "
+                                                         "the test is calibrated on the ILS ratio)")
+    if validation == "none":
+        ratio_threshold = 0.0
+    stop = ratio_threshold if ratio_threshold > 0 and validation == "ratio" else 1.0  # 1: stop once best is proven
     with np.errstate(divide="ignore", invalid="ignore"):  # an unfinished search has no 2nd cost: ratio NaN / inf
         z, ratio, finished, rot, bounded = _search(grp, method, np.asarray(F, float), max_nodes, stop)
-    sr = _success_rates(grp.Qa)
-    accepted = finished & ((ratio >= ratio_threshold) | (ratio_threshold <= 0))
+    sr, bounds = _success_rates(grp.Qa)
+    mu = np.full(len(z), np.nan)
+    if validation == "ffrt":
+        mu = _ffrt_mu(grp.Qa, bounds[:, 0], pf, ffrt_samples)
+        accepted = finished & (1.0 / ratio <= mu)
+    else:
+        accepted = finished & ((ratio >= ratio_threshold) | (ratio_threshold <= 0))
     b, Qb = conditioned(grp, z.astype(float))
     b = np.where(accepted[:, None], b, grp.b_hat)
     Qb = np.where(accepted[:, None, None], Qb, grp.Qb)
@@ -105,14 +124,23 @@ def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float 
     partial = np.zeros(len(z), bool)
     if partial_p0 is not None and method == "lambda":
         _partial(grp, partial_p0, accepted, partial, b, Qb, z_check, Zs)
-    return Resolution(zf, ratio, accepted, partial, np.asarray(sr, float).reshape(-1), finished, b, Qb, rot,
-                      z_check, Zs, bounded)
+    return Resolution(zf, ratio, accepted, partial, sr, finished, b, Qb, rot, z_check, Zs, bounded, bounds, mu)
 
 
-def _success_rates(Qa: np.ndarray) -> np.ndarray:
-    """Bootstrapped success rate (K,) after decorrelation."""
-    d = amb.ils_batch(np.zeros(Qa.shape[:2]), Qa, n_cands=1).d
-    return amb.bootstrap_success_rate(d=d)
+def _ffrt_mu(Qa, lower, pf, n_samples):
+    """FF-ratio threshold mu (K,): 1 where the ILS failure rate is proven <= pf, Monte Carlo calibrated elsewhere
+    (seeded by the epoch count: deterministic)."""
+    mu = np.ones(len(Qa))
+    need = np.flatnonzero(~(1.0 - lower <= pf))
+    if need.size:
+        mu[need] = amb.ffrt_thresholds(Qa[need], pf, n_samples, seed=len(Qa))
+    return mu
+
+
+def _success_rates(Qa: np.ndarray):
+    """Bootstrapped success rate (K,) after decorrelation and the ILS success-rate bounds (K, 2) [lower, upper]."""
+    b = amb.ils_success_bounds(Qa)
+    return b["bootstrap"], np.stack([b["lower"], b["upper"]], axis=-1)
 
 
 def _partial(grp, p0, accepted, partial, b, Qb, z_check, Zs):
@@ -167,7 +195,7 @@ def resolve_held(grp: FloatGroup, method: str, F: np.ndarray, breaks: np.ndarray
     epochs of the run keep that fix (their ``ratio`` is NaN: not searched). Epochs before it are searched."""
     searched, first, run = _first_fixes(grp, np.asarray(breaks, bool), method, F, kw)
     K = len(run)
-    fields = {f: [] for f in ("z", "ratio", "accepted", "partial", "finished", "rotation", "bounded")}
+    fields = {f: [] for f in ("z", "ratio", "accepted", "partial", "finished", "rotation", "bounded", "mu")}
     z_check, Zs, b, Qb = [None] * K, [None] * K, grp.b_hat.copy(), grp.Qb.copy()
     held = (first[run] >= 0) & (np.arange(K) > first[run])
     zh = np.zeros(grp.a_hat.shape)
@@ -185,5 +213,7 @@ def resolve_held(grp: FloatGroup, method: str, F: np.ndarray, breaks: np.ndarray
     out = {f: np.array(v) for f, v in fields.items()}
     out["ratio"][held] = np.nan
     out["rotation"][held] = np.nan
-    return Resolution(out["z"], out["ratio"], out["accepted"], out["partial"], _success_rates(grp.Qa),
-                      out["finished"], b, Qb, out["rotation"], z_check, Zs, out["bounded"])
+    out["mu"][held] = np.nan
+    sr, bounds = _success_rates(grp.Qa)
+    return Resolution(out["z"], out["ratio"], out["accepted"], out["partial"], sr, out["finished"], b, Qb,
+                      out["rotation"], z_check, Zs, out["bounded"], bounds, out["mu"])

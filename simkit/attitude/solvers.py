@@ -76,7 +76,7 @@ def _empty(M: int, r: int, g: int, s: int, names) -> dict:
     x = len(names)
     return {"quat": np.full((M, 4), nan), "euler": np.full((M, 3), nan), "cov": np.full((M, x, x), nan),
             "status": np.full(M, -1, np.int8), "ratio": np.full(M, nan), "ratio_is_bound": np.zeros(M, bool),
-            "success_rate": np.full(M, nan),
+            "success_rate": np.full(M, nan), "success_rate_bounds": np.full((M, 2), nan), "ffrt_mu": np.full(M, nan),
             "n_sats": np.zeros(M, np.int16), "dd_ambiguity": np.full((M, r, g, s), nan),
             "dd_ambiguity_true": np.full((M, r, g, s), nan), "reference_sat": np.full((M, g, s), -1, np.int16),
             "baseline_enu": np.full((M, r, 3), nan), "baseline_body": np.full((M, r, 3), nan),
@@ -94,6 +94,7 @@ def _store(out: dict, grp: FloatGroup, res: Resolution, fd: FileData, R, cov):
     out["status"][e] = np.where(wrong, 3, status)
     out["ratio"][e], out["success_rate"][e] = res.ratio, res.success_rate
     out["ratio_is_bound"][e] = res.bounded
+    out["success_rate_bounds"][e], out["ffrt_mu"][e] = res.sr_bounds, res.mu
     out["n_sats"][e] = len(np.unique(np.concatenate([grp.sat, grp.ref])))
     for k in range(r):
         rows = slice(k * n, (k + 1) * n)
@@ -120,7 +121,8 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
                             bool(p["static"]), fd.lli)
     for grp in _progress(groups, progress, f"attitude ({method})"):
         kw = dict(ratio_threshold=p["ratio_threshold"], partial_p0=p["partial_p0"] or None,
-                  max_nodes=int(p["max_nodes"]))
+                  max_nodes=int(p["max_nodes"]), validation=p["validation"], pf=p["pf"],
+                  ffrt_samples=int(p["ffrt_samples"]))
         if p["continuity"] and p["every"] == 1:
             res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), **kw)
         else:
@@ -136,7 +138,7 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
 
 
 _UNITS = {"status": "-1 none, 0 float, 1 fixed, 2 partial, 3 wrong fix", "ratio": "1", "ratio_is_bound": "bool",
-          "success_rate": "1",
+          "success_rate": "1", "success_rate_bounds": "1 (lower, upper)", "ffrt_mu": "1",
           "n_sats": "1", "dd_ambiguity": "cycles", "dd_ambiguity_true": "cycles",
           "reference_sat": "index into /gnss/sat_id", "baseline_enu": "m", "baseline_body": "m",
           "baseline_float_enu": "m", "atdop": "rad/m", "atdop_weighted": "rad/m (x sigma_dd_carrier: the weighted "
