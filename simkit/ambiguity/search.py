@@ -243,6 +243,14 @@ def _ils_batch_kernel(A, Qs, m, max_nodes):
 _ILS = jit_when_ready(_ils_kernel, lambda a, *_: a.shape[0], max_interpreted_n=40)
 
 
+def _unpack(buf, n, squares, k):
+    """Part ``k`` of a buffer packed by ``_ils_kernel``: ``squares`` (n, n) matrices first, then (n,) vectors."""
+    if k < squares:
+        return buf[k * n * n:(k + 1) * n * n].reshape(n, n)
+    start = squares * n * n + (k - squares) * n
+    return buf[start:start + n]
+
+
 class ILSResult:
     """Integer least-squares solution of one problem.
 
@@ -260,35 +268,12 @@ class ILSResult:
         self.candidates, self.sqnorms, self.finished, self.nodes = candidates, sqnorms, finished, nodes
         self._floats, self._ints = floats, ints
 
-    @property
-    def L(self):
-        n = self.candidates.shape[1]
-        return self._floats[:n * n].reshape(n, n)
-
-    @property
-    def d(self):
-        n = self.candidates.shape[1]
-        return self._floats[n * n:n * n + n]
-
-    @property
-    def z_hat(self):
-        n = self.candidates.shape[1]
-        return self._floats[n * n + n:]
-
-    @property
-    def Z(self):
-        n = self.candidates.shape[1]
-        return self._ints[:n * n].reshape(n, n)
-
-    @property
-    def Zti(self):
-        n = self.candidates.shape[1]
-        return self._ints[n * n:2 * n * n].reshape(n, n)
-
-    @property
-    def shift(self):
-        n = self.candidates.shape[1]
-        return self._ints[2 * n * n:]
+    L = property(lambda self: _unpack(self._floats, self.candidates.shape[1], 1, 0))
+    d = property(lambda self: _unpack(self._floats, self.candidates.shape[1], 1, 1))
+    z_hat = property(lambda self: _unpack(self._floats, self.candidates.shape[1], 1, 2))
+    Z = property(lambda self: _unpack(self._ints, self.candidates.shape[1], 2, 0))
+    Zti = property(lambda self: _unpack(self._ints, self.candidates.shape[1], 2, 1))
+    shift = property(lambda self: _unpack(self._ints, self.candidates.shape[1], 2, 2))
 
     @property
     def status(self) -> str:

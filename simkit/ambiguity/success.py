@@ -222,21 +222,29 @@ def ils_success_bounds(Q, max_nodes=1_000_000, rounds=0) -> dict:
     return {k: _out(v, single) for k, v in out.items()}
 
 
+def simulated_solutions(Qs, n_samples, rng, n_cands, chunk=50_000):
+    """Monte Carlo ILS of a stack ``Qs`` (K, n, n) (cycles^2): ``n_samples`` draws a_hat ~ N(0, Q_k) per problem,
+    solved in batches of about ``chunk``. Yields (slice of k, :class:`~.search.ILSBatchResult` of its
+    len(slice) * n_samples problems, problem-major); the true integers are 0. Draws in epoch order
+    (deterministic for a seeded ``rng``)."""
+    from .search import ils_batch
+
+    K, n = Qs.shape[:2]
+    L = np.linalg.cholesky(Qs)
+    step = max(1, chunk // n_samples)
+    for s in range(0, K, step):
+        k = slice(s, min(s + step, K))
+        e = np.einsum("kij,ksj->ksi", L[k], rng.standard_normal((L[k].shape[0], n_samples, n)))
+        yield k, ils_batch(e.reshape(-1, n), np.repeat(Qs[k], n_samples, axis=0), n_cands=n_cands)
+
+
 def monte_carlo_success_rates(Q, n_samples, rng, chunk=50_000):
     """Monte Carlo ILS success rate of each covariance of a stack ``Q`` (K, n, n) (cycles^2): ``n_samples`` draws
     a_hat ~ N(0, Q_k) each, solved in batches of about ``chunk`` problems. Returns (rates (K,), standard errors
     (K,)); ``rng`` a seeded ``numpy.random.Generator`` (draws in epoch order: deterministic)."""
-    from .search import ils_batch
-
     Qs, _ = _as_stack(Q)
-    K, n = Qs.shape[:2]
     N = int(n_samples)
-    ok = np.zeros(K)
-    L = np.linalg.cholesky(Qs)
-    step = max(1, chunk // N)
-    for s in range(0, K, step):
-        k = slice(s, min(s + step, K))
-        e = np.einsum("kij,ksj->ksi", L[k], rng.standard_normal((L[k].shape[0], N, n)))
-        res = ils_batch(e.reshape(-1, n), np.repeat(Qs[k], N, axis=0), n_cands=1)
+    ok = np.zeros(Qs.shape[0])
+    for k, res in simulated_solutions(Qs, N, rng, 1, chunk):
         ok[k] = np.all(res.candidates[:, 0, :] == 0, axis=1).reshape(-1, N).mean(axis=1)
     return ok, np.sqrt(np.maximum(ok * (1.0 - ok), 1e-300) / N)

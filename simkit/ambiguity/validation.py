@@ -14,7 +14,7 @@ import numpy as np
 from .decorrelation import as_problem, decorrelate
 from .errors import AmbiguityInputError
 from .search import ils, ils_batch
-from .success import bootstrap_success_rate
+from .success import bootstrap_success_rate, simulated_solutions
 
 # Fixed threshold: 3, the default of RTKLIB (option pos2-arthres = 3.0) and the commonly used empirical value
 # (e.g. Landau & Euler 1992 used 2; 3 is the common conservative choice). Equivalent to mu = 1/3.
@@ -110,16 +110,10 @@ def ffrt_thresholds(Q, failure_rate=1e-3, n_samples=10_000, rng=None, seed=0, ch
     if Qs.ndim != 3:
         raise AmbiguityInputError("Q", f"shape {Qs.shape}; expected (K, n, n)")
     rng = np.random.default_rng(seed) if rng is None else rng
-    K, n = Qs.shape[:2]
     N = int(n_samples)
     allowed = int(math.floor(failure_rate * N))
-    mu = np.ones(K)
-    L = np.linalg.cholesky(Qs)
-    step = max(1, chunk // N)
-    for s in range(0, K, step):
-        k = slice(s, min(s + step, K))
-        e = np.einsum("kij,ksj->ksi", L[k], rng.standard_normal((L[k].shape[0], N, n)))
-        res = ils_batch(e.reshape(-1, n), np.repeat(Qs[k], N, axis=0), n_cands=2)
+    mu = np.ones(Qs.shape[0])
+    for k, res in simulated_solutions(Qs, N, rng, 2, chunk):
         wrong = np.any(res.candidates[:, 0, :] != 0, axis=1)
         ratio = np.where(wrong, res.sqnorms[:, 0] / res.sqnorms[:, 1], np.inf).reshape(-1, N)
         cut = np.sort(ratio, axis=1)[:, allowed]  # the (allowed+1)-th failure; inf: too few failures
