@@ -93,11 +93,13 @@ def reduce_into(U, d, ZT, ZtiT):
     """Decorrelate in place: integer Gauss transforms and permutations on (L, d), accumulated into Z and Zti.
 
     Works on the transposes, ``U = L^T``, ``ZT = Z^T`` and ``ZtiT = Zti^T``: every Gauss transform and swap then
-    runs along contiguous rows instead of strided columns, which halves the time at n = 40 (the operations and
-    their order are those of the column form, so the results are bit-identical). ``ZT`` and ``ZtiT`` must hold
-    the identity (int64) on entry.
+    runs along contiguous rows instead of strided columns (the operations and their order are those of the column
+    form, so the results are bit-identical). The swaps of ``ZT`` and ``ZtiT`` are only recorded in a row
+    permutation, applied once at the end. Together about 1.5x faster at n = 40. ``ZT`` and ``ZtiT`` must hold the
+    identity (int64) on entry.
     """
     n = d.shape[0]
+    row = np.arange(n)  # logical row r of ZT and ZtiT is stored in row[r]
     last_swap = n - 2
     i = n - 2
     while i >= 0:
@@ -109,22 +111,46 @@ def reduce_into(U, d, ZT, ZtiT):
                 for k in range(j, n):
                     U[i, k] -= mu * U[j, k]
                 imu = np.int64(mu)
+                ri, rj = row[i], row[j]
                 for k in range(n):
-                    ZT[i, k] -= imu * ZT[j, k]
-                    ZtiT[j, k] += imu * ZtiT[i, k]
+                    ZT[ri, k] -= imu * ZT[rj, k]
+                for k in range(n):
+                    ZtiT[rj, k] += imu * ZtiT[ri, k]
         lij = U[i, i + 1]
         delta = d[i] + lij * lij * d[i + 1]
         if delta < d[i + 1]:
-            _swap(U, d, ZT, ZtiT, i, lij, delta)
+            _swap(U, d, i, lij, delta)
+            row[i], row[i + 1] = row[i + 1], row[i]
             last_swap = i
             i = n - 2
         else:
             i -= 1
+    _permute_rows(ZT, row)
+    _permute_rows(ZtiT, row)
 
 
 @njit(cache=True)
-def _swap(U, d, ZT, ZtiT, i, lij, delta):
-    """Permute ambiguities ``i`` and ``i + 1`` (transposed layout, see :func:`reduce_into`)."""
+def _permute_rows(A, row):
+    """``A[r] = A_old[row[r]]`` for every r, in place (one row of scratch, following the permutation's cycles)."""
+    n = A.shape[0]
+    done = np.zeros(n, dtype=np.bool_)
+    tmp = np.empty(A.shape[1], dtype=A.dtype)
+    for start in range(n):
+        if done[start] or row[start] == start:
+            continue
+        tmp[:] = A[start]
+        r = start
+        while row[r] != start:
+            A[r] = A[row[r]]
+            done[r] = True
+            r = row[r]
+        A[r] = tmp
+        done[r] = True
+
+
+@njit(cache=True)
+def _swap(U, d, i, lij, delta):
+    """Permute ambiguities ``i`` and ``i + 1`` in (U = L^T, d) (see :func:`reduce_into`)."""
     n = d.shape[0]
     lam = d[i + 1] * lij / delta
     eta = d[i] / delta
@@ -140,13 +166,6 @@ def _swap(U, d, ZT, ZtiT, i, lij, delta):
         t = U[i, k]
         U[i, k] = U[i + 1, k]
         U[i + 1, k] = t
-    for k in range(n):
-        t = ZT[i, k]
-        ZT[i, k] = ZT[i + 1, k]
-        ZT[i + 1, k] = t
-        t = ZtiT[i, k]
-        ZtiT[i, k] = ZtiT[i + 1, k]
-        ZtiT[i + 1, k] = t
 
 
 def raise_for_status(code: int, i: int, j: int, what: str = "") -> None:
