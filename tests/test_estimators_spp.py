@@ -62,7 +62,7 @@ def test_broadcast_correction_removes_the_simulated_ionosphere_exactly(files):
     dp = ecef_to_enu_vec(fx.pos_ecef - pos, lla[:, 0], lla[:, 1])
     dp_raw = ecef_to_enu_vec(raw.pos_ecef - pos, lla[:, 0], lla[:, 1])
     assert fx.ionosphere.startswith("broadcast Klobuchar (C, G)") and raw.ionosphere.startswith("none")
-    # measured: 0.14 mm as without ionosphere (the correction is the simulated delay); uncorrected: metres
+    # measured: 0.17 mm, 0.38 mm/s (0.14 mm without ionosphere: the correction is the simulated delay)
     assert iono > 1.0 and np.abs(dp).max() < 1e-3
     assert np.abs(dp_raw[:, 2]).max() > 1.0
     assert np.abs(fx.vel_enu - vel).max() < 5e-3  # the ionosphere's rate (mm/s) stays in the Doppler velocity
