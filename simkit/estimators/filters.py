@@ -39,7 +39,7 @@ class FilterConfig:
     ``gyro_bias0``/``accel_bias0`` initial bias estimates (body); ``dd_gate_p`` (kf15_dd) rejects a DD carrier
     epoch whose NIS exceeds the chi-square(m rows) quantile 1 - dd_gate_p (0: no gate); ``update_at_start``: use
     the measurements that fall on the initial epoch (False when the initial state was built from them, as the
-    "motion" and "attitude" alignments of ``simkit solve`` do: they would count twice)."""
+    "static", "motion" and "attitude" alignments of ``simkit solve`` do: they would count twice)."""
 
     gyro_arw: float = 1e-4
     accel_vrw: float = 1e-3

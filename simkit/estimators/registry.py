@@ -206,8 +206,9 @@ def filter_config(ds, p, name) -> FilterConfig:
         p0_vel=float(p["p0_vel_m_per_s"]), p0_pos=tuple(np.broadcast_to(np.asarray(p["p0_pos_m"], float), 3)),
         p0_lever=float(p.get("p0_lever_m", 0.5)), cov_dt=float(p["cov_dt_s"]), alpha=float(p.get("alpha", 10.0)),
         gamma_rule=str(p.get("gamma_rule", "wu")), dd_gate_p=float(p.get("dd_gate_p", 0.0)),
-        # "motion" and "attitude" build the initial state from the measurements of the initial epoch
-        update_at_start=p.get("align") not in ("motion", "attitude"))
+        # "static", "motion" and "attitude" take the initial position (and attitude) from the fixes of the initial
+        # epoch: only "truth" leaves them independent, to be used as measurements
+        update_at_start=p.get("align") == "truth")
 
 
 def _attitude_alignment(ds, p, gnss: GnssFixes, good):
