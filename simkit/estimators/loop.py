@@ -1,6 +1,7 @@
 """The filter recursion (numba): strapdown at the IMU rate, covariance propagation every ``cov_dt`` s and before
 each update, loosely coupled position/velocity updates at the GNSS epochs, GNSS attitude updates, closed-loop
-feedback (the error state is reset to zero after each correction). ``mode`` 0 = Kalman, 1 = H-infinity with Wu's
+feedback (the error state is reset to zero after each correction); measurements that fall on sample 0 (the initial
+epoch) are applied before the first step. ``mode`` 0 = Kalman, 1 = H-infinity with Wu's
 gamma rule, 2 = H-infinity with the weighted gamma rule."""
 from __future__ import annotations
 
@@ -99,9 +100,7 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_
         g_due = ig < gk.size and gk[ig] == s
         a_due = ia < ak.size and ak[ia] == s
         d_due = idd < dk.size and dk[idd] == s
-        if tacc == 0.0:
-            pass
-        elif tacc >= cov_dt - 1e-9 or g_due or a_due or d_due:
+        if tacc > 0.0 and (tacc >= cov_dt - 1e-9 or g_due or a_due or d_due):
             phim, qd = model.discretise(model.system_matrix(c, v, pos, fsum / tacc, p.shape[0]), qc, tacc)
             p = phim @ p @ phim.T + qd
             fsum, tacc = np.zeros(3), 0.0
