@@ -24,11 +24,10 @@ def _feedback(x, c, v, pos, bg, ba, lever):
 
 
 @njit(cache=True)
-def _update(p, nu, h, r, mode, alpha):
-    x = np.zeros(p.shape[0])
-    if mode >= 1:
-        return kalman.correct_hinf(x, p, nu, h, r, alpha, mode == 2)
-    x, p, nis, w, status = kalman.correct(x, p, nu, h, r)
+def _kalman(p, nu, h, r):
+    """The Kalman correction of the zero error state, as the H-infinity correction's 7-tuple (x, P, nis, w,
+    gamma NaN, margin NaN, status)."""
+    x, p, nis, w, status = kalman.correct(np.zeros(p.shape[0]), p, nu, h, r)
     return x, p, nis, w, np.nan, np.nan, status
 
 
@@ -107,7 +106,7 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_
         elif k % 64 == 0:
             c = nav.orthonormalise(c)
         # the updates of this sample, in order: GNSS attitude, fixed DD carrier, position/velocity. One call
-        # site of _update: numba/LLVM compile the Kalman and H-infinity corrections into the loop once
+        # site per correction, in the loop itself: numba/LLVM optimise the corrections into the loop once
         for kind in range(3):
             if kind == 0 and a_due:
                 nu, h = _att_rows(c, az[ia], p.shape[0])
@@ -119,7 +118,8 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_
                 r = gr[ig]
             else:
                 continue
-            res = _update(p, nu, h, r, mode, alpha)
+            res = kalman.correct_hinf(np.zeros(p.shape[0]), p, nu, h, r, alpha, mode == 2) if mode >= 1 else \
+                _kalman(p, nu, h, r)
             gated = kind == 1 and not res[2] <= dd[7][idd]  # DD innovation gate (inf: off): state left alone
             if not gated:
                 p = res[1]
