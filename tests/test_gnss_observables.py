@@ -234,3 +234,15 @@ def test_noise_of_a_satellite_does_not_depend_on_the_mask_or_the_other_satellite
     assert both.sum() > 500 and (np.isfinite(a["obs/L1C/code"]) & ~both).sum() > 100
     for term in ("noise_code", "noise_carrier", "noise_doppler"):
         np.testing.assert_array_equal(a[f"truth/L1C/{term}"][both], b[f"truth/L1C/{term}"][both], err_msg=term)
+
+
+def test_static_output_carries_the_broadcast_klobuchar_coefficients_used():
+    """A scenario override wins for GPS; this nav file's header has no IONOSPHERIC CORR lines, so BDS gets the
+    defaults (the BDSA/BDSB lines of BRDM00DLR_S_20261170000_01D_MN.rnx); rows follow /gnss/iono_systems."""
+    from simkit.gnss import atmosphere
+
+    alpha, beta = [1.0e-8, 2.0e-8, -6.0e-8, -1.2e-7], [9.0e4, 1.0e5, -6.5e4, -5.2e5]
+    st = make({"ionosphere": {"gps_alpha": alpha, "gps_beta": beta}}, duration=2.0).static()
+    assert st.iono_systems.tolist() == ["G", "C"]
+    np.testing.assert_array_equal(st.iono_alpha, [alpha, atmosphere.DEFAULT_BDS_ALPHA])
+    np.testing.assert_array_equal(st.iono_beta, [beta, atmosphere.DEFAULT_BDS_BETA])

@@ -37,7 +37,9 @@ class FilterConfig:
     ``alpha`` H-infinity tuning (Wu 2015: 10); ``gamma_rule``
     "wu" (Wu's H^T H, with the weighted rule as fallback) or "weighted" (H^T R^-1 H);
     ``gyro_bias0``/``accel_bias0`` initial bias estimates (body); ``dd_gate_p`` (kf15_dd) rejects a DD carrier
-    epoch whose NIS exceeds the chi-square(m rows) quantile 1 - dd_gate_p (0: no gate)."""
+    epoch whose NIS exceeds the chi-square(m rows) quantile 1 - dd_gate_p (0: no gate); ``update_at_start``: use
+    the measurements that fall on the initial epoch (False when the initial state was built from them, as the
+    "static", "motion" and "attitude" alignments of ``simkit solve`` do: they would count twice)."""
 
     gyro_arw: float = 1e-4
     accel_vrw: float = 1e-3
@@ -55,6 +57,7 @@ class FilterConfig:
     accel_bias0: tuple = (0.0, 0.0, 0.0)
     gamma_rule: str = "wu"
     dd_gate_p: float = 0.0
+    update_at_start: bool = True
 
 
 def _p0(cfg: FilterConfig, n: int, lat: float, h: float) -> np.ndarray:
@@ -78,19 +81,20 @@ def _qc(cfg: FilterConfig, n: int) -> np.ndarray:
     return q
 
 
-def sample_index(t_imu: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Index of the IMU sample at each time of ``t`` (within half an IMU interval), -1 where none (or t[0])."""
+def sample_index(t_imu: np.ndarray, t: np.ndarray, first: int = 0) -> np.ndarray:
+    """Index of the IMU sample at each time of ``t`` (within half an IMU interval), -1 where none or before
+    sample ``first``."""
     j = np.clip(np.searchsorted(t_imu, t), 1, t_imu.size - 1)
     j = np.where(np.abs(t_imu[j - 1] - t) < np.abs(t_imu[j] - t), j - 1, j)
     half = 0.5 * np.median(np.diff(t_imu))
-    ok = (np.abs(t_imu[j] - t) <= half + 1e-9) & (j > 0)
+    ok = (np.abs(t_imu[j] - t) <= half + 1e-9) & (j >= first)
     return np.where(ok, j, -1)
 
 
-def _gnss_arrays(gnss: GnssFixes, t_imu):
+def _gnss_arrays(gnss: GnssFixes, t_imu, first: int):
     lla = ecef_to_lla(gnss.pos_ecef)
-    k = sample_index(t_imu, gnss.t)
-    good = (k > 0) & np.isfinite(lla).all(1) & np.isfinite(gnss.vel_enu).all(1)
+    k = sample_index(t_imu, gnss.t, first)
+    good = (k >= 0) & np.isfinite(lla).all(1) & np.isfinite(gnss.vel_enu).all(1)
     good &= np.concatenate([[True], np.diff(k) > 0])
     idx = np.flatnonzero(good)
     z = np.concatenate([lla[idx], gnss.vel_enu[idx]], axis=1)
@@ -102,11 +106,11 @@ def _gnss_arrays(gnss: GnssFixes, t_imu):
     return idx, (k[idx].astype(np.int64), z, r)
 
 
-def _att_arrays(att: AttitudeFixes | None, t_imu):
+def _att_arrays(att: AttitudeFixes | None, t_imu, first: int):
     if att is None:
         return (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3, 3)))
-    k = sample_index(t_imu, att.t)
-    good = (k > 0) & np.isfinite(att.euler).all(1)
+    k = sample_index(t_imu, att.t, first)
+    good = (k >= 0) & np.isfinite(att.euler).all(1)
     good &= np.concatenate([[True], np.diff(k) > 0])
     return (k[good].astype(np.int64), att.euler[good], att.cov[good])
 
@@ -118,13 +122,13 @@ def _spans(starts, lengths):
     return (np.repeat(np.asarray(starts, np.int64) - first, lengths) + np.arange(lengths.sum())).astype(np.int64)
 
 
-def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0):
+def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0, first: int = 1):
     """The loop's DD tuple (epochs at an IMU sample, one per sample, first kept), row and covariance offsets."""
     if dd is None:
         return (np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
                 np.zeros(1, np.int64), np.zeros(0), np.zeros(0))
-    k = sample_index(t_imu, dd.t)
-    good = (k > 0) & np.concatenate([[True], np.diff(k) > 0])
+    k = sample_index(t_imu, dd.t, first)
+    good = (k >= 0) & np.concatenate([[True], np.diff(k) > 0])
     idx = np.flatnonzero(good)
     m = np.diff(dd.offsets)
     rows = _spans(dd.offsets[idx], m[idx])
@@ -165,9 +169,10 @@ class _LooselyCoupled:
         pos0 = np.asarray(init.pos_lla, float)
         nav0 = (Rotation.from_quat(init.quat_nb).as_matrix(), np.asarray(init.vel_enu, float), pos0,
                 np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy())
-        idx, garr = _gnss_arrays(gnss, imu.t)
-        aarr = _att_arrays(attitude if n > 15 else None, imu.t)
-        darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p))
+        first = 0 if cfg.update_at_start else 1  # sample 0 is the initial epoch
+        idx, garr = _gnss_arrays(gnss, imu.t, first)
+        aarr = _att_arrays(attitude if n > 15 else None, imu.t, first)
+        darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p), first)
         out = loop.allocate(idx.size, n)
         att_nis, dd_nis = np.full(aarr[0].size, np.nan), np.full(darr[0].size, np.nan)
         loop.run(phi, dvb, dt, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), garr, aarr,

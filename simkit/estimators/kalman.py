@@ -48,6 +48,41 @@ def _chol(s):
 
 
 @njit(cache=True)
+def _lower_solve(l, b):
+    """L^-1 B for lower-triangular ``l`` (m, m) and ``b`` (m, k), by forward substitution."""
+    m, k = b.shape
+    y = np.empty((m, k))
+    for i in range(m):
+        for j in range(k):
+            acc = b[i, j]
+            for q in range(i):
+                acc -= l[i, q] * y[q, j]
+            y[i, j] = acc / l[i, i]
+    return y
+
+
+@njit(cache=True)
+def _upper_solve(l, b):
+    """L^-T B for lower-triangular ``l`` (m, m) and ``b`` (m, k), by back substitution."""
+    m, k = b.shape
+    y = np.empty((m, k))
+    for i in range(m - 1, -1, -1):
+        for j in range(k):
+            acc = b[i, j]
+            for q in range(i + 1, m):
+                acc -= l[q, i] * y[q, j]
+            y[i, j] = acc / l[i, i]
+    return y
+
+
+@njit(cache=True)
+def chol_solve(l, b):
+    """S^-1 B for S = L L^T (``l`` its Cholesky factor), ``b`` (m, k). Hand-written (with :func:`_chol`) so that
+    the filter loop instantiates no LAPACK wrapper: those dominate numba's compile time."""
+    return _upper_solve(l, _lower_solve(l, b))
+
+
+@njit(cache=True)
 def correct(x, p, nu, h, r):
     """Kalman correction with innovation ``nu`` = z - H x. Returns (x, P, nis, w standardised, status)."""
     s = h @ p @ h.T + r
@@ -55,8 +90,8 @@ def correct(x, p, nu, h, r):
     m = nu.size
     if l.shape[0] == 0:
         return x, p, np.nan, np.full(m, np.nan), STATUS_S_NOT_PD
-    w = np.linalg.solve(l, nu)
-    k = np.linalg.solve(s, h @ p).T
+    w = _lower_solve(l, nu.reshape((m, 1)))[:, 0]
+    k = chol_solve(l, h @ p).T
     ikh = np.eye(p.shape[0]) - k @ h
     p_new = ikh @ p @ ikh.T + k @ r @ k.T
     return x + k @ nu, 0.5 * (p_new + p_new.T), np.sum(w * w), w, STATUS_OK
@@ -67,7 +102,7 @@ def hinf_gamma(p, h, alpha):
     """Wu 2015's adaptive gamma: sqrt(alpha * max eig((P^-1 + H^T H)^-1)), with (P^-1 + H^T H)^-1 formed as
     P - P H^T (I + H P H^T)^-1 H P (matrix inversion lemma: no inverse of the ill-scaled P)."""
     hp = h @ p
-    m = p - hp.T @ np.linalg.solve(np.eye(h.shape[0]) + hp @ h.T, hp)
+    m = p - hp.T @ chol_solve(_chol(np.eye(h.shape[0]) + hp @ h.T), hp)
     return np.sqrt(alpha * np.linalg.eigvalsh(0.5 * (m + m.T))[-1])
 
 
@@ -100,7 +135,7 @@ def correct_hinf(x, p, nu, h, r, alpha, weighted=False):
     ls = _chol(h @ p @ h.T + r)
     if l.shape[0] == 0 or ls.shape[0] == 0:
         return x, p, np.nan, np.full(nu.size, np.nan), np.nan, np.nan, STATUS_S_NOT_PD
-    r_inv = np.linalg.inv(r)
+    r_inv = chol_solve(_chol(r), np.eye(r.shape[0]))
     theta = weighted_theta(p, h, r, alpha) if weighted else 1.0 / hinf_gamma(p, h, alpha) ** 2
     margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
     status = STATUS_OK
@@ -112,10 +147,10 @@ def correct_hinf(x, p, nu, h, r, alpha, weighted=False):
             theta *= 0.5
             margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
     e = _existence(l, h, r_inv, theta)
-    p_new = l @ np.linalg.solve(e, l.T)
+    p_new = l @ chol_solve(_chol(e), l.T.copy())
     p_new = 0.5 * (p_new + p_new.T)
     k = p_new @ h.T @ r_inv
-    w = np.linalg.solve(ls, nu)
+    w = _lower_solve(ls, nu.reshape((nu.size, 1)))[:, 0]
     return x + k @ nu, p_new, np.sum(w * w), w, 1.0 / np.sqrt(theta), margin, status
 
 

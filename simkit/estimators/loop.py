@@ -1,6 +1,7 @@
 """The filter recursion (numba): strapdown at the IMU rate, covariance propagation every ``cov_dt`` s and before
 each update, loosely coupled position/velocity updates at the GNSS epochs, GNSS attitude updates, closed-loop
-feedback (the error state is reset to zero after each correction). ``mode`` 0 = Kalman, 1 = H-infinity with Wu's
+feedback (the error state is reset to zero after each correction); measurements that fall on sample 0 (the initial
+epoch) are applied before the first step. ``mode`` 0 = Kalman, 1 = H-infinity with Wu's
 gamma rule, 2 = H-infinity with the weighted gamma rule."""
 from __future__ import annotations
 
@@ -23,40 +24,40 @@ def _feedback(x, c, v, pos, bg, ba, lever):
 
 
 @njit(cache=True)
-def _update(p, nu, h, r, mode, alpha):
-    x = np.zeros(p.shape[0])
-    if mode >= 1:
-        return kalman.correct_hinf(x, p, nu, h, r, alpha, mode == 2)
-    x, p, nis, w, status = kalman.correct(x, p, nu, h, r)
+def _kalman(p, nu, h, r):
+    """The Kalman correction of the zero error state, as the H-infinity correction's 7-tuple (x, P, nis, w,
+    gamma NaN, margin NaN, status)."""
+    x, p, nis, w, status = kalman.correct(np.zeros(p.shape[0]), p, nu, h, r)
     return x, p, nis, w, np.nan, np.nan, status
 
 
 @njit(cache=True)
-def _pv_update(p, c, v, pos, lever, w_ib, z, r, mode, alpha):
-    pred, h = model.antenna_rows(c, v, pos, lever, w_ib, p.shape[0])
+def _pv_rows(c, v, pos, lever, w_ib, z, n):
+    """Innovation (INS minus GNSS) and H of a position/velocity fix at the antenna."""
+    pred, h = model.antenna_rows(c, v, pos, lever, w_ib, n)
     nu = pred - z
     nu[1] = model.wrap(nu[1])
-    return _update(p, nu, h, r, mode, alpha)
+    return nu, h
 
 
 @njit(cache=True)
-def _att_update(p, c, z, r, mode, alpha):
-    e, h = model.attitude_rows(c, p.shape[0])
+def _att_rows(c, z, n):
+    """Innovation (INS minus GNSS, wrapped) and H of a GNSS attitude fix [pitch, roll, heading]."""
+    e, h = model.attitude_rows(c, n)
     nu = e - z
     for i in range(3):
         nu[i] = model.wrap(nu[i])
-    return _update(p, nu, h, r, mode, alpha)
+    return nu, h
 
 
 @njit(cache=True)
-def _dd_update(p, c, dd, i, mode, alpha):
-    """Update with the fixed DD carrier rows of DD epoch ``i`` (see :func:`model.dd_rows`), INS minus GNSS."""
+def _dd_rows(c, dd, i, n):
+    """Innovation, H and R of the fixed DD carrier rows of DD epoch ``i`` (see :func:`model.dd_rows`)."""
     off, los, base, z, roff, cov = dd[1], dd[2], dd[3], dd[4], dd[5], dd[6]
     a, b = off[i], off[i + 1]
     m = b - a
-    pred, h = model.dd_rows(c, los[a:b], base[a:b], p.shape[0])
-    r = cov[roff[i]:roff[i + 1]].copy().reshape((m, m))
-    return _update(p, pred - z[a:b], h, r, mode, alpha)
+    pred, h = model.dd_rows(c, los[a:b], base[a:b], n)
+    return pred - z[a:b], h, cov[roff[i]:roff[i + 1]].copy().reshape((m, m))
 
 
 @njit(cache=True)
@@ -87,38 +88,49 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_
     v_prev = v.copy()
     fsum, tacc = np.zeros(3), 0.0
     ig, ia, idd = 0, 0, 0
-    for k in range(dt.size):
-        s = k + 1
-        ph, dv = phi[k] - bg * dt[k], dvb[k] - ba * dt[k]
-        c, v_new, pos, fn = nav.step(c, v, pos, v_prev, ph, dv, dt[k])
-        v_prev, v = v, v_new
-        fsum += fn * dt[k]
-        tacc += dt[k]
+    for s in range(dt.size + 1):  # sample s; interval k = s - 1 leads to it (sample 0: the initial epoch)
+        k = max(s - 1, 0)
+        ph = phi[k] - bg * dt[k]
+        if s > 0:
+            c, v_new, pos, fn = nav.step(c, v, pos, v_prev, ph, dvb[k] - ba * dt[k], dt[k])
+            v_prev, v = v, v_new
+            fsum += fn * dt[k]
+            tacc += dt[k]
         g_due = ig < gk.size and gk[ig] == s
         a_due = ia < ak.size and ak[ia] == s
         d_due = idd < dk.size and dk[idd] == s
-        if tacc >= cov_dt - 1e-9 or g_due or a_due or d_due:
+        if tacc > 0.0 and (tacc >= cov_dt - 1e-9 or g_due or a_due or d_due):
             phim, qd = model.discretise(model.system_matrix(c, v, pos, fsum / tacc, p.shape[0]), qc, tacc)
             p = phim @ p @ phim.T + qd
             fsum, tacc = np.zeros(3), 0.0
         elif k % 64 == 0:
             c = nav.orthonormalise(c)
-        if a_due:
-            res = _att_update(p, c, az[ia], ar[ia], mode, alpha)
-            p, att_nis[ia] = res[1], res[2]
-            c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
-            ia += 1
-        if d_due:
-            res = _dd_update(p, c, dd, idd, mode, alpha)
-            dd_nis[idd] = res[2]
-            if res[2] <= dd[7][idd]:  # innovation gate (inf: off); a rejected epoch leaves the state alone
+        # the updates of this sample, in order: GNSS attitude, fixed DD carrier, position/velocity. One call
+        # site per correction, in the loop itself: numba/LLVM optimise the corrections into the loop once
+        for kind in range(3):
+            if kind == 0 and a_due:
+                nu, h = _att_rows(c, az[ia], p.shape[0])
+                r = ar[ia]
+            elif kind == 1 and d_due:
+                nu, h, r = _dd_rows(c, dd, idd, p.shape[0])
+            elif kind == 2 and g_due:
+                nu, h = _pv_rows(c, v, pos, lever, ph / dt[k], gz[ig], p.shape[0])
+                r = gr[ig]
+            else:
+                continue
+            res = kalman.correct_hinf(np.zeros(p.shape[0]), p, nu, h, r, alpha, mode == 2) if mode >= 1 else \
+                _kalman(p, nu, h, r)
+            gated = kind == 1 and not res[2] <= dd[7][idd]  # DD innovation gate (inf: off): state left alone
+            if not gated:
                 p = res[1]
                 c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
-            idd += 1
-        if g_due:
-            res = _pv_update(p, c, v, pos, lever, ph / dt[k], gz[ig], gr[ig], mode, alpha)
-            p = res[1]
-            c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
-            _record(out, ig, c, v, pos, p, bg, ba, lever, res)
-            ig += 1
+            if kind == 0:
+                att_nis[ia] = res[2]
+                ia += 1
+            elif kind == 1:
+                dd_nis[idd] = res[2]
+                idd += 1
+            else:
+                _record(out, ig, c, v, pos, p, bg, ba, lever, res)
+                ig += 1
     return out

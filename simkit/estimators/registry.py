@@ -17,10 +17,10 @@ from .align import motion_alignment, static_alignment
 from .errors import EstimatorInputError
 from .filters import FilterConfig, HInfinityFilter, KalmanFilter15, KalmanFilter15DD, KalmanFilter21
 from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData, InitialState
-from .spp import spp
+from .spp import SppFixes, spp
 
 COMMON = {"gnss": "spp", "antenna": 0, "elevation_mask_deg": 10.0, "sigma_code_m": 3.0,
-          "sigma_doppler_m_per_s": 0.1, "truth_pos_sigma_m": [1.0, 1.0, 5.0], "truth_vel_sigma_m_per_s": 0.05,
+          "sigma_doppler_m_per_s": 0.1, "ionosphere": "broadcast", "truth_pos_sigma_m": [1.0, 1.0, 5.0], "truth_vel_sigma_m_per_s": 0.05,
           "seed": 0}
 FILTER = {"align": "motion", "align_static_s": 10.0, "init_heading_error_deg": 0.0, "p0_att_deg": [1.0, 1.0, 10.0],
           "p0_vel_m_per_s": 0.5, "p0_pos_m": [5.0, 5.0, 10.0], "gyro_arw": None, "accel_vrw": None,
@@ -35,7 +35,8 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
                         "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
                         "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6, "dd_correlation_s": 0.0,
                         "dd_correlation_window_s": 0.0}}
-CHOICES = {"gamma_rule": ("wu", "weighted"), "dd_method": ("lambda", "clambda", "mclambda"),
+CHOICES = {"gamma_rule": ("wu", "weighted"), "ionosphere": ("broadcast", "none"),
+           "dd_method": ("lambda", "clambda", "mclambda"),
            "attitude_source": ("auto", "truth", "attitude"),
            "align": ("auto", "static", "motion", "truth", "attitude"),
            "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
@@ -99,6 +100,20 @@ def _antenna(ds, p) -> int:
     return a
 
 
+def broadcast_ionosphere(ds, p):
+    """(``{system: (alpha, beta)}`` or None, why): the file's broadcast Klobuchar coefficients when
+    ``p['ionosphere']`` is "broadcast" and the file has them (files written before /gnss/iono_alpha existed
+    have not: no correction, and the reason says so)."""
+    if p["ionosphere"] == "none":
+        return None, "none (estimator.ionosphere = none)"
+    if "gnss/iono_alpha" not in ds:
+        return None, f"none ({ds.path} has no /gnss/iono_alpha: written before simkit stored the broadcast model)"
+    systems = [str(x.decode() if isinstance(x, bytes) else x) for x in ds["gnss/iono_systems"][:]]
+    alpha, beta = ds["gnss/iono_alpha"][:], ds["gnss/iono_beta"][:]
+    coef = {k: (alpha[i], beta[i]) for i, k in enumerate(systems)}
+    return coef, "broadcast Klobuchar (" + ", ".join(sorted(coef)) + ") from /gnss/iono_alpha, /gnss/iono_beta"
+
+
 def spp_fixes(ds, p):
     """Single-point fixes of antenna ``p['antenna']`` from /gnss/obs (first tracked signal per satellite)."""
     sat_ids = ds["gnss/sat_id"][:]
@@ -114,8 +129,12 @@ def spp_fixes(ds, p):
             wl, gd = np.full(c.shape[1], lam[j]), gd_all[:, j].copy()
         take = np.isnan(code).all(0) & ~np.isnan(c).all(0)
         code[:, take], doppler[:, take], wl[take], gd[take] = c[:, take], d[:, take], lam[j], gd_all[take, j]
-    return spp(ds["gnss/t"][:], code, doppler, wl, ds["gnss/sat_pos_ecef"][:], ds["gnss/sat_clock"][:],
-               _system_of(sat_ids), gd, p["elevation_mask_deg"], p["sigma_code_m"], p["sigma_doppler_m_per_s"])
+    iono, why = broadcast_ionosphere(ds, p)
+    t = ds["gnss/t"][:]
+    fx = spp(t, code, doppler, wl, ds["gnss/sat_pos_ecef"][:], ds["gnss/sat_clock"][:], _system_of(sat_ids), gd,
+             p["elevation_mask_deg"], p["sigma_code_m"], p["sigma_doppler_m_per_s"], iono_coefficients=iono,
+             gps_sow=float(ds.attrs["start_gps_sow"]) + t)
+    return SppFixes(**{**fx.__dict__, "ionosphere": why})
 
 
 def solve_spp(ds, params, progress=False) -> Solution:
@@ -128,7 +147,8 @@ def solve_spp(ds, params, progress=False) -> Solution:
                     extras={"clock": fx.clock, "n_sats": fx.n_sats},
                     extra_units={"clock": "m (one column per system: " + ",".join(fx.systems) + ")",
                                  "n_sats": "1"},
-                    config={"estimator": "spp", "point": f"antenna {p['antenna']} phase centre", **p})
+                    config={"estimator": "spp", "point": f"antenna {p['antenna']} phase centre",
+                            "ionosphere_correction": fx.ionosphere, **p})
 
 
 def _truth_fixes(ds, p):
@@ -190,7 +210,10 @@ def filter_config(ds, p, name) -> FilterConfig:
         p0_att=tuple(np.radians(np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3))),
         p0_vel=float(p["p0_vel_m_per_s"]), p0_pos=tuple(np.broadcast_to(np.asarray(p["p0_pos_m"], float), 3)),
         p0_lever=float(p.get("p0_lever_m", 0.5)), cov_dt=float(p["cov_dt_s"]), alpha=float(p.get("alpha", 10.0)),
-        gamma_rule=str(p.get("gamma_rule", "wu")), dd_gate_p=float(p.get("dd_gate_p", 0.0)))
+        gamma_rule=str(p.get("gamma_rule", "wu")), dd_gate_p=float(p.get("dd_gate_p", 0.0)),
+        # "static", "motion" and "attitude" take the initial position (and attitude) from the fixes of the initial
+        # epoch: only "truth" leaves them independent, to be used as measurements
+        update_at_start=p.get("align") == "truth")
 
 
 def _attitude_alignment(ds, p, gnss: GnssFixes, good, stop_s: float | None = None):
@@ -338,9 +361,11 @@ def solve_filter(name):
         init = initial_state(ds, {**p, "align": align}, imu, gnss, found)
         att = _attitude(ds, p) if name == "kf21" and p["use_attitude"] else None
         dd = dd_carrier(ds, p) if name == "kf15_dd" else None
-        sol = cls(filter_config(ds, p, name), init).run(imu, gnss, att, dd=dd)
+        sol = cls(filter_config(ds, {**p, "align": align}, name), init).run(imu, gnss, att, dd=dd)
         extra = {"attitude_source": attitude_source(ds, p)} if name == "kf21" and p["use_attitude"] else {}
         extra["align_used"] = align
+        if p["gnss"] == "spp":
+            extra["ionosphere_correction"] = broadcast_ionosphere(ds, p)[1]
         return Solution(**{**sol.__dict__, "config": {**sol.config, "params": p, **extra}})
 
     solve.__doc__ = f"simkit solve --filter {name}: {cls.__doc__.splitlines()[0]}"

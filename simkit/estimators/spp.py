@@ -5,8 +5,10 @@ Model per satellite s at epoch k (one signal per satellite, the first tracked in
     -lambda D + c dT^s' - e_s . v^s - w_e (v^s_x y - v^s_y x) / c = -e_s . v + c dt'
 with r^s, dT^s the file's satellite position at emission and clock (RTKLIB's satposs convention, the Sagnac term
 added here), GD the code group delay of ``/gnss/group_delay``, T the Saastamoinen slant delay of
-:mod:`simkit.gnss.atmosphere`, one receiver clock per system (G, C, ...), one clock drift; the ionosphere is not
-modelled (single frequency, no broadcast coefficients in the file), which biases the fix by metres. Satellite
+:mod:`simkit.gnss.atmosphere`, one receiver clock per system (G, C, ...), one clock drift. With broadcast
+Klobuchar coefficients (``iono_coefficients``, from ``/gnss/iono_alpha``/``iono_beta``) the code is also corrected
+for the broadcast ionospheric delay I(el, az) (f_ref/f)^2 of :func:`simkit.gnss.atmosphere.broadcast_ionosphere`
+(P - I on the left); without them the ionosphere is not modelled, which biases the fix by metres. Satellite
 velocity and clock drift are central differences of the stored epochs (second order at the ends); the receiver's
 own Sagnac-rate term (w_e (x^s v_y - y^s v_x) / c, under 1 mm/s) is left out. Weights sin^2(el) / sigma^2; the
 covariance is sigma^2 (A^T W A)^-1 with the a-priori ``sigma_code_m`` and ``sigma_doppler_m_per_s``.
@@ -19,7 +21,7 @@ import numpy as np
 
 from ..earth import C_LIGHT, OMEGA_E
 from ..frames import ecef_to_enu_matrix, ecef_to_lla
-from ..gnss.atmosphere import troposphere
+from ..gnss.atmosphere import broadcast_ionosphere, reference_frequency, troposphere
 from .errors import EstimatorInputError
 
 
@@ -27,7 +29,7 @@ from .errors import EstimatorInputError
 class SppFixes:
     """``t`` (M,) s; ``pos_ecef`` (M, 3) m and ``vel_enu`` (M, 3) m/s of the antenna (NaN where no fix);
     ``pos_cov_enu`` (M, 3, 3) m^2, ``vel_cov_enu`` (M, 3, 3) (m/s)^2; ``clock`` (M, n_sys) m per system in
-    ``systems``; ``n_sats`` (M,) satellites used."""
+    ``systems``; ``n_sats`` (M,) satellites used; ``ionosphere`` the ionospheric correction applied."""
 
     t: np.ndarray
     pos_ecef: np.ndarray
@@ -37,6 +39,7 @@ class SppFixes:
     clock: np.ndarray
     systems: tuple
     n_sats: np.ndarray
+    ionosphere: str = "none"
 
 
 def _geometry(r, sat):
@@ -48,10 +51,34 @@ def _geometry(r, sat):
 
 
 def _elevation(r, e):
+    """Elevation and azimuth (clockwise from north) (M, S) rad of the lines of sight ``e``, and the receiver's
+    geodetic lat, lon, h (M, 3)."""
     lla = ecef_to_lla(r)
-    m = ecef_to_enu_matrix(lla[:, 0], lla[:, 1])
-    up = np.einsum("mj,msj->ms", m[:, 2, :], e)
-    return np.arcsin(np.clip(up, -1, 1)), lla
+    enu = np.einsum("mij,msj->msi", ecef_to_enu_matrix(lla[:, 0], lla[:, 1]), e)
+    return np.arcsin(np.clip(enu[..., 2], -1, 1)), np.arctan2(enu[..., 0], enu[..., 1]), lla
+
+
+@dataclass(frozen=True)
+class _Delays:
+    """Atmospheric code corrections: broadcast Klobuchar ``iono`` ({system: (alpha, beta)} or None) scaled to each
+    satellite's signal by ``iono_scale`` (S,), at GPS seconds of week ``gps_sow`` (M,); ``systems`` (S,)."""
+
+    iono: dict | None
+    iono_scale: np.ndarray
+    gps_sow: np.ndarray | None
+    systems: np.ndarray
+
+    def __call__(self, lla, el, az):
+        """Slant troposphere plus broadcast ionosphere (M, S) m."""
+        el = np.clip(el, 0.05, None)
+        lat, lon = lla[:, None, 0], lla[:, None, 1]
+        out = troposphere(lat, np.clip(lla[:, None, 2], -500, 1e5), el)
+        for sys, (alpha, beta) in (self.iono or {}).items():
+            cols = self.systems == sys
+            if cols.any():
+                out[:, cols] += self.iono_scale[cols] * broadcast_ionosphere(
+                    sys, alpha, beta, lat, lon, az[:, cols], el[:, cols], self.gps_sow[:, None])
+        return out
 
 
 def _solve(a, y, w, mask):
@@ -67,18 +94,17 @@ def _solve(a, y, w, mask):
     return np.einsum("mij,mj->mi", ninv, b), ninv, ok
 
 
-def _position(code, sat, sys_onehot, mask_rad, sigma, iterations):
+def _position(code, sat, sys_onehot, mask_rad, sigma, iterations, delays):
     m, s = code.shape
     x = np.zeros((m, 3 + sys_onehot.shape[1]))
     used = np.isfinite(code)
     for it in range(iterations):
         rho, e = _geometry(x[:, :3], sat)
-        el, lla = _elevation(x[:, :3], e)
-        late = it >= 3
-        trop = troposphere(lla[:, None, 0], np.clip(lla[:, None, 2], -500, 1e5), np.clip(el, 0.05, None)) if late \
-            else 0.0
+        el, az, lla = _elevation(x[:, :3], e)
+        late = it >= 3  # the atmosphere, mask and weights once the position is near (from the Earth's centre)
+        atm = delays(lla, el, az) if late else 0.0
         used = np.isfinite(code) & ((el >= mask_rad) if late else True)
-        y = np.nan_to_num(code - trop - rho - x[:, 3:] @ sys_onehot.T)
+        y = np.nan_to_num(code - atm - rho - x[:, 3:] @ sys_onehot.T)
         a = np.concatenate([-e, np.broadcast_to(sys_onehot, (m, s, sys_onehot.shape[1]))], axis=-1)
         w = (np.clip(np.sin(el), 0.1, 1.0) ** 2 if late else np.ones((m, s))) / sigma**2
         dx, ninv, ok = _solve(a, y, w, used)
@@ -86,23 +112,44 @@ def _position(code, sat, sys_onehot, mask_rad, sigma, iterations):
     return x, e, el, used, ninv, ok
 
 
+def _delays(systems, wavelength_m, iono_coefficients, gps_sow, m) -> _Delays:
+    if iono_coefficients is None:
+        return _Delays(None, np.zeros(len(systems)), None, systems)
+    bad = sorted(set(iono_coefficients) - {"G", "C"})
+    if bad:
+        raise EstimatorInputError(f"spp: iono_coefficients: no broadcast model for system(s) {bad}; expected 'G', 'C'")
+    if gps_sow is None or np.shape(gps_sow) != (m,):
+        raise EstimatorInputError(f"spp: gps_sow: expected ({m},) GPS seconds of week with iono_coefficients, "
+                                  f"got {None if gps_sow is None else np.shape(gps_sow)}")
+    coef = {k: (np.asarray(a, float), np.asarray(b, float)) for k, (a, b) in iono_coefficients.items()}
+    if any(a.shape != (4,) or b.shape != (4,) for a, b in coef.values()):
+        raise EstimatorInputError("spp: iono_coefficients: expected {system: (alpha (4,), beta (4,))}")
+    freq = C_LIGHT / np.asarray(wavelength_m, float)
+    ref = np.array([reference_frequency(k) if k in coef else np.nan for k in systems])
+    return _Delays(coef, np.nan_to_num((ref / freq) ** 2), np.asarray(gps_sow, float), systems)
+
+
 def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, group_delay_m=None,
-        elevation_mask_deg=10.0, sigma_code_m=3.0, sigma_doppler_m_per_s=0.1, iterations=10) -> SppFixes:
+        elevation_mask_deg=10.0, sigma_code_m=3.0, sigma_doppler_m_per_s=0.1, iterations=10,
+        iono_coefficients=None, gps_sow=None) -> SppFixes:
     """Single-point position and velocity. ``code`` (M, S) m and ``doppler`` (M, S) Hz of one antenna (NaN
     where not tracked); ``wavelength_m`` (S,) per satellite's signal; ``sat_pos_ecef`` (M, S, 3) m;
-    ``sat_clock_s`` (M, S) s; ``systems`` (S,) system letters; ``group_delay_m`` (S,) m."""
+    ``sat_clock_s`` (M, S) s; ``systems`` (S,) system letters; ``group_delay_m`` (S,) m;
+    ``iono_coefficients`` {'G' or 'C': (alpha (4,), beta (4,))} broadcast Klobuchar coefficients (s, s/semicircle,
+    ...; None: no ionospheric correction) with ``gps_sow`` (M,) the epochs' GPS seconds of week."""
     t, code, doppler = np.asarray(t, float), np.asarray(code, float), np.asarray(doppler, float)
     m, s = code.shape
     if sat_pos_ecef.shape != (m, s, 3) or doppler.shape != (m, s) or sat_clock_s.shape != (m, s):
         raise EstimatorInputError(f"spp: expected code/doppler (M, S), sat_pos_ecef (M, S, 3), sat_clock (M, S) "
                                   f"with M={m}, S={s}; got {doppler.shape}, {sat_pos_ecef.shape}, {sat_clock_s.shape}")
+    systems = np.asarray(systems)
     names = tuple(sorted(set(systems)))
-    onehot = (np.asarray(systems)[:, None] == np.array(names)[None, :]).astype(float)
+    onehot = (systems[:, None] == np.array(names)[None, :]).astype(float)
     gd = np.zeros(s) if group_delay_m is None else np.nan_to_num(np.asarray(group_delay_m, float))
     sat = np.nan_to_num(sat_pos_ecef)
     corrected = code + C_LIGHT * sat_clock_s - gd
     x, e, el, used, ninv, ok = _position(corrected, sat, onehot, np.radians(elevation_mask_deg), sigma_code_m,
-                                         iterations)
+                                         iterations, _delays(systems, wavelength_m, iono_coefficients, gps_sow, m))
     n_used = used.sum(1)
     good = ok & (n_used >= 3 + (onehot[None] * used[..., None]).any(1).sum(1))
     x[~good] = np.nan
@@ -113,7 +160,9 @@ def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, grou
     w_pos = np.einsum("mij,mjk,mlk->mil", rot, ninv[:, :3, :3], rot)
     vel_enu = np.einsum("mij,mj->mi", rot, vel)
     v_cov = np.einsum("mij,mjk,mlk->mil", rot, vcov, rot)
-    return SppFixes(t, x[:, :3], vel_enu, w_pos, v_cov, x[:, 3:], names, np.where(good, n_used, 0))
+    iono = "none" if iono_coefficients is None else \
+        "broadcast Klobuchar (" + ", ".join(sorted(iono_coefficients)) + ")"
+    return SppFixes(t, x[:, :3], vel_enu, w_pos, v_cov, x[:, 3:], names, np.where(good, n_used, 0), iono)
 
 
 def _velocity(t, doppler, wavelength, sat, clk, r, e, el, used, sigma):

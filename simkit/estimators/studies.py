@@ -5,6 +5,8 @@
 ``wu [--runs N] [--white]``       KF vs H-infinity RMS per axis on high_dynamic with unmodelled coloured IMU noise
                                   (--white: the preset's own white noise and biases, which the filters model)
 ``pyins FILE``                    simkit kf15 and pyins' feedback filter on the same data (needs python-ins)
+``spp FILE``                      SPP antenna position error (mean, RMS per ENU axis) without / with the broadcast
+                                  ionospheric correction
 Every study reads simkit files and prints JSON; nothing here is used by the filters themselves.
 """
 from __future__ import annotations
@@ -17,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..frames import ecef_to_enu_vec
+from ..frames import ecef_to_enu_vec, ecef_to_lla
 from ..io import open_dataset
 from .evaluate import errors_vs_truth, rms_table
 from .registry import SOLVERS
@@ -71,6 +73,25 @@ def badshah(path, plot=None, heading_error_deg=10.0) -> dict:
     return out
 
 
+def spp_bias(path, antenna=0) -> dict:
+    """SPP position error of antenna ``antenna`` vs its true phase centre (ENU mean and RMS, m), without
+    (``ionosphere = none``) and with (``broadcast``) the file's Klobuchar correction."""
+    from .registry import DEFAULTS, spp_fixes
+
+    out = {}
+    with open_dataset(path) as ds:
+        pos = ds["gnss/truth/antenna_pos_ecef"][:, antenna]
+        for iono in ("none", "broadcast"):
+            fx = spp_fixes(ds, {**DEFAULTS["spp"], "antenna": antenna, "ionosphere": iono})
+            ok = np.isfinite(fx.pos_ecef).all(1)
+            lla = ecef_to_lla(pos[ok])
+            dp = ecef_to_enu_vec(fx.pos_ecef[ok] - pos[ok], lla[:, 0], lla[:, 1])
+            out[iono] = {"correction": fx.ionosphere, "fixes": int(ok.sum()),
+                         "mean_enu_m": dp.mean(0).round(3).tolist(),
+                         "rms_enu_m": np.sqrt(np.mean(dp**2, axis=0)).round(3).tolist()}
+    return out
+
+
 def _plot_heading(curves, out):
     import matplotlib
 
@@ -118,7 +139,7 @@ def wu(runs=10, seed0=1, workdir=None, skip_s=10.0, coloured=True) -> dict:
 
 def main(argv=None):
     p = argparse.ArgumentParser(prog="python -m simkit.estimators.studies", description=__doc__.splitlines()[0])
-    p.add_argument("study", choices=("drift", "badshah", "wu", "pyins"))
+    p.add_argument("study", choices=("drift", "badshah", "wu", "pyins", "spp"))
     p.add_argument("file", nargs="?")
     p.add_argument("--seconds", type=float)
     p.add_argument("--plot")
@@ -131,6 +152,8 @@ def main(argv=None):
         res = badshah(a.file, a.plot)
     elif a.study == "wu":
         res = wu(a.runs, coloured=not a.white)
+    elif a.study == "spp":
+        res = spp_bias(a.file)
     else:
         from .peer import compare_pyins
         res = compare_pyins(a.file)

@@ -99,6 +99,21 @@ def troposphere_rate(lat, h, el, h_rate, el_rate, dh: float = 1.0):
     return dz_dh * h_rate / s - (zh + zw) * np.cos(el) / s**2 * el_rate
 
 
+def broadcast_ionosphere(system: str, alpha, beta, lat, lon, az, el, gps_tow):
+    """Broadcast Klobuchar delay (m) of ``system`` ('G': GPS model on L1; 'C': BDS model on B1I, BDT from GPS
+    time) at receiver ``lat``/``lon`` rad, satellite ``az``/``el`` rad, GPS seconds of week ``gps_tow``."""
+    if system == "G":
+        return klobuchar_gps(alpha, beta, lat, lon, az, el, gps_tow)
+    if system == "C":
+        return klobuchar_bds(alpha, beta, lat, lon, az, el, gps_tow + BDT_MINUS_GPST)
+    raise ValueError(f"system: {system!r} has no broadcast Klobuchar model; expected 'G' or 'C'")
+
+
+def reference_frequency(system: str) -> float:
+    """Frequency (Hz) the broadcast model of ``system`` refers to: L1 for 'G', B1I for 'C'."""
+    return F_L1 if system == "G" else F_B1I
+
+
 def ionosphere(system: str, alpha, beta, lla, vel_enu, az, el, az_rate, el_rate, gps_tow, h: float = 0.05):
     """Broadcast ionospheric delay (m, at the system's reference frequency: L1 for 'G', B1I for 'C') and its rate
     (m/s) for receivers at ``lla`` (..., 3) moving at ``vel_enu`` (..., 3) m/s, satellites at ``az``/``el`` rad
@@ -107,14 +122,13 @@ def ionosphere(system: str, alpha, beta, lla, vel_enu, az, el, az_rate, el_rate,
     The rate is a central difference over +-``h`` s along both motions (receiver latitude/longitude rates
     from the radii of curvature, satellite angles linearly): the model's curvature leaves < 1e-6 m/s.
     """
-    model, shift = (klobuchar_gps, 0.0) if system == "G" else (klobuchar_bds, BDT_MINUS_GPST)
     lat, lon, hgt = lla[..., 0], lla[..., 1], lla[..., 2]
     rm, rn = earth.radii(lat)
     lat_rate = vel_enu[..., 1] / (rm + hgt)
     lon_rate = vel_enu[..., 0] / ((rn + hgt) * np.cos(lat))
 
     def at(s):
-        return model(alpha, beta, (lat + s * lat_rate)[..., None], (lon + s * lon_rate)[..., None],
-                     az + s * az_rate, el + s * el_rate, gps_tow + shift + s)
+        return broadcast_ionosphere(system, alpha, beta, (lat + s * lat_rate)[..., None],
+                                    (lon + s * lon_rate)[..., None], az + s * az_rate, el + s * el_rate, gps_tow + s)
 
     return at(0.0), (at(h) - at(-h)) / (2.0 * h)

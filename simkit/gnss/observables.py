@@ -13,7 +13,8 @@ import numpy as np
 @dataclass(frozen=True)
 class GnssStatic:
     """Time-independent description: ids (S,), signal names, frequencies and wavelengths (G,), group delays
-    (S, G) m, antenna lever arms and boresights (A, 3) in body axes."""
+    (S, G) m, antenna lever arms and boresights (A, 3) in body axes, and the broadcast Klobuchar coefficients
+    (Y, 4) per system of ``iono_systems`` (Y,) ('G', 'C'), alpha in s, s/sc, s/sc^2, s/sc^3 and beta likewise."""
 
     sat_id: np.ndarray
     signals: np.ndarray
@@ -22,6 +23,9 @@ class GnssStatic:
     group_delay: np.ndarray
     lever_arm_b: np.ndarray
     boresight_b: np.ndarray
+    iono_systems: np.ndarray
+    iono_alpha: np.ndarray
+    iono_beta: np.ndarray
 
 
 @dataclass(frozen=True)

@@ -102,7 +102,14 @@ class GnssSimulator:
                           frequency_hz=np.array([g.freq_hz for g in self.signals]),
                           wavelength_m=np.array([g.wavelength_m for g in self.signals]),
                           group_delay=self.group_delay_s * C_LIGHT * self.cfg.errors["group_delay"],
-                          lever_arm_b=self.lever, boresight_b=self.boresight)
+                          lever_arm_b=self.lever, boresight_b=self.boresight, **self._klobuchar_rows())
+
+    def _klobuchar_rows(self) -> dict[str, np.ndarray]:
+        """The broadcast Klobuchar coefficients used, one row per simulated system with a model (G, C)."""
+        systems = [k for k in self.iono if k in set(self.system)]
+        return {"iono_systems": np.array(systems, dtype="U1"),
+                "iono_alpha": np.array([self.iono[k][0] for k in systems], dtype=float).reshape(-1, 4),
+                "iono_beta": np.array([self.iono[k][1] for k in systems], dtype=float).reshape(-1, 4)}
 
     def process(self, t, pos_ecef, vel_ecef, quat_nb, omega_ib_b) -> GnssEpochs:
         """Observables at epochs ``t`` (M,) s (on the ``gnss.rate_hz`` grid, in order across calls) from the
@@ -250,7 +257,7 @@ class _Parts:
         rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
         cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, g.cn0_offset_db)
         sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g))
-        scale = ((atmosphere.F_L1 if g.system == "G" else atmosphere.F_B1I) / g.freq_hz) ** 2
+        scale = (atmosphere.reference_frequency(g.system) / g.freq_hz) ** 2
         iono, iono_rate = self.iono[..., cj] * scale, self.iono_rate[..., cj] * scale
         el = self.el[..., cj]
         if self.mp is not None:

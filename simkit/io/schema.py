@@ -5,7 +5,7 @@ a path, dtype or shape that is not declared here and takes the units from here; 
 the RINEX exporter, the ``/solutions`` writer and the README table (``python -m simkit.io.schema``) follow it.
 
 Shape symbols: N truth/IMU samples, M GNSS epochs, A antennas, S satellites, G signals, K solution epochs,
-X solution states, R campaign runs. Placeholders in paths: ``<signal>`` a signal name (``L1C``, ``B1I``, ...),
+X solution states, Y satellite systems with a broadcast ionosphere model, R campaign runs. Placeholders in paths: ``<signal>`` a signal name (``L1C``, ``B1I``, ...),
 ``<term>`` an IMU error term (``gyro_bias``, ``accel_white``, ...), ``<name>`` a solution name, ``<extra>`` a
 filter's extra output.
 """
@@ -81,6 +81,13 @@ _GNSS = [
     _f("gnss/frequency_hz", "f8", ("G",), "Hz", "", "gnss", "carrier frequency per signal"),
     _f("gnss/wavelength_m", "f8", ("G",), "m", "", "gnss", "carrier wavelength per signal"),
     _f("gnss/group_delay", "f8", ("S", "G"), "m", "", "gnss", "code group delay applied (c TGD-type term)"),
+    _f("gnss/iono_systems", "str", ("Y",), "", "", "gnss",
+       "systems of the rows of iono_alpha/iono_beta: 'G' (GPS, L1 model) or 'C' (BDS, B1I model)"),
+    _f("gnss/iono_alpha", "f8", ("Y", 4), "s, s/sc, s/sc^2, s/sc^3", "", "gnss",
+       "broadcast Klobuchar amplitude coefficients of the navigation data (RINEX GPSA/BDSA; sc = semicircle); "
+       "the simulated ionosphere is this model when gnss.errors.ionosphere is on"),
+    _f("gnss/iono_beta", "f8", ("Y", 4), "s, s/sc, s/sc^2, s/sc^3", "", "gnss",
+       "broadcast Klobuchar period coefficients (RINEX GPSB/BDSB)"),
     _f("gnss/sat_pos_ecef", "f8", ("M", "S", 3), "m", "ECEF at emission", "gnss",
        "satellite at emission time for the IMU centre, in the ECEF frame of the emission epoch (RTKLIB satposs)"),
     _f("gnss/sat_clock", "f8", ("M", "S"), "s", "", "gnss",
