@@ -38,8 +38,11 @@ class Stages:
 
 
 def run(scenario, out=None, seed=None, overrides=None, progress=False, block_samples: int = BLOCK_SAMPLES,
-        force: bool = False) -> Path:
+        force: bool = False, threads: int | None = None) -> Path:
     """Simulate a scenario into ``out`` (default ``<scenario name>.h5``); returns the output path.
+
+    ``threads``: threads compressing the output (1: on the calling thread; default
+    :func:`simkit.io.writer.compression_threads`).
 
     Everything that can be checked is checked before the first sample: the scenario, the constellation sources
     and their coverage of the run, the output path, and the output size (refused above the free disk space or
@@ -55,7 +58,7 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
     source = None if isinstance(scenario, dict) else _scenario_file(scenario)
     check_output(out, inputs=[source], estimated_bytes=size, force=force)
     stages = build(sc, sky)
-    with Writer(out, root_attributes(sc)) as w:
+    with Writer(out, root_attributes(sc), threads) as w:
         _write(w, sc, stages, block_samples, progress)
     return out
 

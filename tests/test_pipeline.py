@@ -19,12 +19,22 @@ def _arrays(path):
 
 
 def test_same_scenario_and_seed_give_identical_arrays(tmp_path):
+    """Also when one run compresses on its own thread (as campaign runs do) and the other in a thread pool."""
     a = simkit.run("quickstart", out=tmp_path / "a.h5", overrides=["scenario.duration_s=20"])
-    b = simkit.run("quickstart", out=tmp_path / "b.h5", overrides=["scenario.duration_s=20"])
+    b = simkit.run("quickstart", out=tmp_path / "b.h5", overrides=["scenario.duration_s=20"], threads=1)
     xa, xb = _arrays(a), _arrays(b)
     assert xa.keys() == xb.keys() and "truth/f_ib_b" in xa
     for k in xa:
         assert np.array_equal(xa[k], xb[k], equal_nan=xa[k].dtype.kind == "f"), k
+
+
+def test_bad_thread_count_in_the_environment_is_one_clean_line(tmp_path):
+    env = {**__import__("os").environ, "SIMKIT_NUM_THREADS": "two"}
+    out = subprocess.run([sys.executable, "-m", "simkit", "run", "quickstart", "-o", str(tmp_path / "q.h5")],
+                         env=env, capture_output=True, text=True)
+    assert out.returncode == 2 and out.stderr.count("\n") == 1
+    assert "$SIMKIT_NUM_THREADS" in out.stderr and "positive integer" in out.stderr
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_file_layout_units_and_provenance(tmp_path):

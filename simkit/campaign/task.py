@@ -6,12 +6,15 @@ atomically, so a run is either complete on disk or absent, never half-written.
 """
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import functools
 import os
 import socket
 import time
 from pathlib import Path
+
+import numba
 
 from ..io import open_dataset
 from ..pipeline import run as simulate
@@ -28,14 +31,15 @@ MMAP_THRESHOLD_BYTES = 32 << 20  # glibc's largest dynamic mmap threshold on 64-
 
 @functools.cache
 def tune_worker_process() -> bool:
-    """Once per process: let glibc keep freed memory for reuse, as it does outside Dask. Returns True if set.
+    """Once per process: make a run behave as it does outside Dask, on one thread. Returns True if glibc took the
+    allocator settings.
 
-    Dask's nanny starts workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to hand memory back to the OS early).
-    That also freezes glibc's mmap threshold at 128 KiB, so every block of a run allocates its large temporaries
-    with fresh ``mmap`` calls and page-faults them in again: a run took 1.7x as long inside a worker as in a
-    plain process (xian_static_bds, 1 h: 1.15 s against 0.68 s). Restoring a large trim threshold and the
-    64-bit maximum mmap threshold brings it back to 0.7 s. Memory stays bounded: a run writes in blocks, so its
-    peak is what it is outside Dask. Other C libraries (musl, macOS) have no such setting and are left alone.
+    - Dask's nanny starts workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to hand memory back to the OS early).
+      That also freezes glibc's mmap threshold at 128 KiB, so every block of a run allocates its large temporaries
+      with fresh ``mmap`` calls and page-faults them in again: a run took 1.7x as long inside a worker as in a
+      plain process (xian_static_bds, 1 h: 0.85 s against 0.50 s). A large trim threshold and the 64-bit maximum
+      mmap threshold bring it back to 0.50 s. Memory stays bounded: a run writes in blocks, so its peak is what it
+      is outside Dask. Other C libraries (musl, macOS) have no such setting and are left alone.
     """
     try:
         mallopt = ctypes.CDLL(None).mallopt
@@ -43,6 +47,22 @@ def tune_worker_process() -> bool:
         return False
     return bool(mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES)) and bool(mallopt(_M_MMAP_THRESHOLD,
                                                                                   MMAP_THRESHOLD_BYTES))
+
+
+@contextlib.contextmanager
+def one_thread():
+    """numba's parallel kernels on one thread for the calling thread, restored on exit.
+
+    The runs are the parallelism of a campaign (one worker per core), so a run keeps to its own thread: its output
+    is compressed on it too (``threads=1``). On 2 cores this took 2 workers from 2.26 to 2.70 runs/s, with 1
+    worker unchanged (``python benchmarks/bench_campaign.py --runs 12 --duration 3600``).
+    """
+    previous = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
 
 
 def base_record(spec: RunSpec) -> dict:
@@ -69,7 +89,8 @@ def execute(spec: RunSpec, run_dir: str, metric_names: tuple[str, ...], previous
     rec = base_record(spec)
     try:
         if previous is None:
-            simulate(spec.scenario, out=h5, seed=spec.seed, overrides=list(spec.overrides))
+            with one_thread():
+                simulate(spec.scenario, out=h5, seed=spec.seed, overrides=list(spec.overrides), threads=1)
             metrics = {}
         else:
             metrics = dict(previous.get("metrics", {}))

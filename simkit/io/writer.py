@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import os
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -20,6 +20,7 @@ import h5py
 import numpy as np
 
 from ..atomic import remove_stale_temporaries, temporary_name
+from ..errors import ScenarioError
 from ..version import __version__
 from . import schema
 from .schema import SCHEMA_VERSION
@@ -55,17 +56,45 @@ class _Series:
         self.n_chunks = 0
 
 
+THREADS_ENV = "SIMKIT_NUM_THREADS"
+
+
+def compression_threads() -> int:
+    """Default number of threads that compress chunks: ``$SIMKIT_NUM_THREADS`` when set (1: compress on the
+    calling thread), else up to 4, one per core. Campaign runs use 1: there the runs are the parallelism."""
+    value = os.environ.get(THREADS_ENV, "").strip()
+    if value:
+        if not value.isdigit() or int(value) < 1:
+            raise ScenarioError(f"${THREADS_ENV}", f"{value!r}; expected a positive integer (compression threads)")
+        return int(value)
+    return max(1, min(4, os.cpu_count() or 1))
+
+
+class _Inline:
+    """The executor interface, running each job at once on the calling thread."""
+
+    @staticmethod
+    def submit(fn, *args) -> Future:
+        done = Future()
+        done.set_result(fn(*args))
+        return done
+
+    def shutdown(self, wait=True, cancel_futures=False) -> None:
+        pass
+
+
 class Writer:
     """Context manager writing one simkit file; ``append`` grows time series block by block."""
 
-    def __init__(self, path: str | Path, attrs: dict):
+    def __init__(self, path: str | Path, attrs: dict, threads: int | None = None):
         self.path = Path(path)
         self.tmp = temporary_name(self.path)
         self.attrs = attrs
         self.file: h5py.File | None = None
         self._series: dict[str, _Series] = {}
         self._jobs: list = []
-        self._pool = ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1)))
+        threads = compression_threads() if threads is None else threads
+        self._pool = _Inline() if threads == 1 else ThreadPoolExecutor(max_workers=threads)
 
     def __enter__(self) -> "Writer":
         remove_stale_temporaries(self.path)
