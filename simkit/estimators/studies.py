@@ -137,6 +137,32 @@ def wu(runs=10, seed0=1, workdir=None, skip_s=10.0, coloured=True) -> dict:
     return res
 
 
+def pyins_seeds(seeds, scenario="airborne_stim300", workdir=None, boot=5000) -> dict:
+    """kf15 against pyins over several seeds of ``scenario`` (:func:`simkit.estimators.peer.compare_pyins` per
+    seed): the RMS over the runs of each filter's per-run RMS, their ratio with a 95 % bootstrap interval over the
+    seeds, and on how many seeds simkit is at least as accurate, per axis."""
+    from ..pipeline import run as simulate
+    from .peer import compare_pyins
+
+    ours, theirs = [], []
+    with tempfile.TemporaryDirectory(dir=workdir) as d:
+        for seed in seeds:
+            res = compare_pyins(simulate(scenario, out=Path(d) / f"run{seed}.h5", seed=seed))
+            ours.append(list(res["simkit_kf15"].values()))
+            theirs.append(list(res["pyins"].values()))
+    cols = list(res["pyins"])
+    o, t = np.array(ours), np.array(theirs)
+    ratio = np.sqrt(np.mean(o ** 2, 0) / np.mean(t ** 2, 0))
+    pick = np.random.default_rng(0).integers(0, len(o), (boot, len(o)))
+    lo, hi = np.percentile(np.sqrt(np.mean(o[pick] ** 2, 1) / np.mean(t[pick] ** 2, 1)), [2.5, 97.5], axis=0)
+    return {"scenario": scenario, "seeds": list(seeds),
+            "simkit_kf15": dict(zip(cols, np.sqrt(np.mean(o ** 2, 0)).round(5).tolist())),
+            "pyins": dict(zip(cols, np.sqrt(np.mean(t ** 2, 0)).round(5).tolist())),
+            "ratio": dict(zip(cols, ratio.round(3).tolist())),
+            "ratio_95": dict(zip(cols, np.column_stack([lo, hi]).round(3).tolist())),
+            "simkit_not_worse_runs": dict(zip(cols, (o <= t).sum(0).tolist()))}
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog="python -m simkit.estimators.studies", description=__doc__.splitlines()[0])
     p.add_argument("study", choices=("drift", "badshah", "wu", "pyins", "spp"))
@@ -145,6 +171,7 @@ def main(argv=None):
     p.add_argument("--plot")
     p.add_argument("--runs", type=int, default=10)
     p.add_argument("--white", action="store_true")
+    p.add_argument("--seeds", help="pyins without FILE: comma-separated seeds of airborne_stim300")
     a = p.parse_args(argv)
     if a.study == "drift":
         res = drift(a.file, a.seconds)
@@ -154,6 +181,8 @@ def main(argv=None):
         res = wu(a.runs, coloured=not a.white)
     elif a.study == "spp":
         res = spp_bias(a.file)
+    elif a.file is None and a.seeds:
+        res = pyins_seeds([int(x) for x in a.seeds.split(",")])
     else:
         from .peer import compare_pyins
         res = compare_pyins(a.file)
