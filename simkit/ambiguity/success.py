@@ -37,10 +37,22 @@ def bootstrap_success_rate(Q=None, d=None, decorrelate_first=True) -> float:
     return float(p) if np.ndim(p) == 0 else p
 
 
+def _adop_of(d):
+    """ADOP (...,) cycles from conditional variances ``d`` (..., n) of any LtDL factorisation (Z-invariant)."""
+    return np.exp(np.mean(np.log(d), axis=-1) / 2.0)
+
+
+def _adop_upper_of(d):
+    """P(chi2_n <= c_n / ADOP^2), c_n = (n/2 Gamma(n/2))^(2/n) / pi, from conditional variances ``d`` (..., n):
+    the ILS pull-in region has volume 1, and no region of volume 1 is more likely than the ellipsoid."""
+    n = np.shape(d)[-1]
+    cn = math.exp((2.0 / n) * (math.log(n / 2.0) + gammaln(n / 2.0))) / math.pi
+    return chi2.cdf(cn / _adop_of(d) ** 2, n)
+
+
 def adop(Q) -> float:
     """Ambiguity dilution of precision, det(Q)^(1/(2n)) (cycles), invariant under Z-transformations."""
-    d = ltdl(Q)[1]
-    return float(np.exp(np.mean(np.log(d)) / 2.0))
+    return float(_adop_of(ltdl(Q)[1]))
 
 
 def adop_success_rate(Q) -> float:
@@ -51,9 +63,7 @@ def adop_success_rate(Q) -> float:
 
 def adop_upper_bound(Q) -> float:
     """ADOP-based upper bound of the ILS success rate: P(chi2_n <= c_n / ADOP^2), c_n = (n/2 Gamma(n/2))^(2/n) / pi."""
-    n = np.shape(Q)[0]
-    cn = math.exp((2.0 / n) * (math.log(n / 2.0) + gammaln(n / 2.0))) / math.pi
-    return float(chi2.cdf(cn / adop(Q) ** 2, n))
+    return float(_adop_upper_of(ltdl(Q)[1]))
 
 
 def success_rate_bounds(Q, decorrelate_first=True) -> dict:
@@ -211,12 +221,10 @@ def ils_success_bounds(Q, max_nodes=1_000_000, rounds=0) -> dict:
     lower bounds, ``upper`` = min of the upper bounds. ``rounds``: see :func:`pullin_upper_bound`.
     """
     Qs, single = _as_stack(Q)
-    n = Qs.shape[1]
     C, s2, done, d = shortest_lattice_vectors(Qs, max_nodes=max_nodes)
-    adop_k = np.exp(np.mean(np.log(d), axis=1) / 2.0)
-    cn = math.exp((2.0 / n) * (math.log(n / 2.0) + gammaln(n / 2.0))) / math.pi
-    out = {"bootstrap": np.atleast_1d(bootstrap_success_rate(d=d)), "pullin_lower": _lower_from(s2[:, 0], n, done),
-           "pullin_upper": _upper_from(Qs, C, max_nodes, rounds), "adop_upper": chi2.cdf(cn / adop_k ** 2, n)}
+    out = {"bootstrap": np.atleast_1d(bootstrap_success_rate(d=d)),
+           "pullin_lower": _lower_from(s2[:, 0], Qs.shape[1], done),
+           "pullin_upper": _upper_from(Qs, C, max_nodes, rounds), "adop_upper": _adop_upper_of(d)}
     out["lower"] = np.fmax(out["bootstrap"], out["pullin_lower"])
     out["upper"] = np.fmin(out["pullin_upper"], out["adop_upper"])
     return {k: _out(v, single) for k, v in out.items()}
