@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..constellation.geometry import angles_from_enu
 from ..earth import C_LIGHT, OMEGA_E
 from ..frames import ecef_to_enu_matrix, ecef_to_lla
 from ..gnss.atmosphere import broadcast_ionosphere, reference_frequency, troposphere
@@ -54,8 +55,8 @@ def _elevation(r, e):
     """Elevation and azimuth (clockwise from north) (M, S) rad of the lines of sight ``e``, and the receiver's
     geodetic lat, lon, h (M, 3)."""
     lla = ecef_to_lla(r)
-    enu = np.einsum("mij,msj->msi", ecef_to_enu_matrix(lla[:, 0], lla[:, 1]), e)
-    return np.arcsin(np.clip(enu[..., 2], -1, 1)), np.arctan2(enu[..., 0], enu[..., 1]), lla
+    el, az = angles_from_enu(np.einsum("mij,msj->msi", ecef_to_enu_matrix(lla[:, 0], lla[:, 1]), e))
+    return el, az, lla
 
 
 @dataclass(frozen=True)
