@@ -184,28 +184,35 @@ def _window_sum(x: np.ndarray, start: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
+def symmetric(P: np.ndarray) -> np.ndarray:
+    """The symmetric part of a stack of matrices (..., n, n): removes the rounding asymmetry of a product."""
+    return 0.5 * (P + np.swapaxes(P, -1, -2))
+
+
+def _window_mean(x: np.ndarray, info: np.ndarray, start: np.ndarray, n: int):
+    """Information-weighted mean (K, d) and its covariance (K, d, d) of the estimates ``x`` (K, d) with
+    information matrices ``info`` (K, d, d) over each epoch's window of the last ``n`` epochs of its run."""
+    P_w = symmetric(np.linalg.inv(_window_sum(info, start, n)))
+    return np.einsum("kij,kj->ki", P_w, _window_sum(np.einsum("kij,kj->ki", info, x), start, n)), P_w
+
+
 def multi_epoch(grp: FloatGroup, breaks: np.ndarray, n: int, static: bool = False) -> FloatGroup:
     """The group's floats over windows of the last ``n`` epochs of each run (``breaks`` (K,) run starts)."""
     start = np.maximum.accumulate(np.where(breaks, np.arange(len(breaks)), 0))
     if static:
         x = np.concatenate([grp.b_hat, grp.a_hat], 1)
         P = np.block([[grp.Qb, grp.Qba], [np.swapaxes(grp.Qba, 1, 2), grp.Qa]])
-        info = np.linalg.inv(P)
-        P_w = np.linalg.inv(_window_sum(info, start, n))
-        x_w = np.einsum("kij,kj->ki", P_w, _window_sum(np.einsum("kij,kj->ki", info, x), start, n))
+        x_w, P_w = _window_mean(x, np.linalg.inv(P), start, n)
         nb = grp.b_hat.shape[1]
-        P_w = 0.5 * (P_w + np.swapaxes(P_w, 1, 2))
         return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, x_w[:, nb:], P_w[:, nb:, nb:], x_w[:, :nb],
                           P_w[:, :nb, :nb], P_w[:, :nb, nb:], grp.G, grp.Qphi, grp.Qphi_correlated)
     info = np.linalg.inv(grp.Qa)
-    Qa_w = np.linalg.inv(_window_sum(info, start, n))
-    Qa_w = 0.5 * (Qa_w + np.swapaxes(Qa_w, 1, 2))
-    a_w = np.einsum("kij,kj->ki", Qa_w, _window_sum(np.einsum("kij,kj->ki", info, grp.a_hat), start, n))
+    a_w, Qa_w = _window_mean(grp.a_hat, info, start, n)
     T = grp.Qba @ info  # Qba Qa^-1
     b_w = grp.b_hat + np.einsum("kij,kj->ki", T, a_w - grp.a_hat)
     Qb_w = grp.Qb - T @ (grp.Qa - Qa_w) @ np.swapaxes(T, 1, 2)
-    return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, a_w, Qa_w, b_w, 0.5 * (Qb_w + np.swapaxes(Qb_w, 1, 2)),
-                      T @ Qa_w, grp.G, grp.Qphi, grp.Qphi_correlated)
+    return FloatGroup(grp.epochs, grp.signal, grp.sat, grp.ref, a_w, Qa_w, b_w, symmetric(Qb_w), T @ Qa_w, grp.G,
+                      grp.Qphi, grp.Qphi_correlated)
 
 
 def _solve_group(obs: Observations, epochs, signal, sat, ref, correlated: bool = False) -> FloatGroup:
@@ -235,11 +242,11 @@ def _solve_group(obs: Observations, epochs, signal, sat, ref, correlated: bool =
         G[:, k * n:(k + 1) * n, 3 * k:3 * k + 3] = G1
     GtW = np.swapaxes(np.linalg.solve(Qp, G), 1, 2)  # G' Qp^-1
     Qb = np.linalg.inv(GtW @ G)
-    Qb = 0.5 * (Qb + np.swapaxes(Qb, 1, 2))
+    Qb = symmetric(Qb)
     b_hat = np.einsum("kij,kj->ki", Qb @ GtW, y_p)
     a_hat = (y_phi - np.einsum("kij,kj->ki", G, b_hat)) / lam
     GQb = G @ Qb
     Qa = (Qphi + GQb @ np.swapaxes(G, 1, 2)) / np.outer(lam, lam)
-    Qa = 0.5 * (Qa + np.swapaxes(Qa, 1, 2))
+    Qa = symmetric(Qa)
     Qba = -np.swapaxes(GQb, 1, 2) / lam
     return FloatGroup(epochs, signal, sat, ref, a_hat, Qa, b_hat, Qb, Qba, G1, Qphi, Qc)

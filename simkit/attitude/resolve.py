@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import ambiguity as amb
-from .dd import FloatGroup
+from .dd import FloatGroup, symmetric
 from .errors import AttitudeInputError
 
 METHODS = ("lambda", "clambda", "mclambda")
@@ -54,7 +54,7 @@ def conditioned(grp: FloatGroup, z: np.ndarray):
     K = np.swapaxes(np.linalg.solve(grp.Qa, np.swapaxes(grp.Qba, 1, 2)), 1, 2)  # Qba Qa^-1
     b = grp.b_hat - np.einsum("kij,kj->ki", K, grp.a_hat - z)
     Qb = grp.Qb - K @ np.swapaxes(grp.Qba, 1, 2)
-    return b, 0.5 * (Qb + np.swapaxes(Qb, 1, 2))
+    return b, symmetric(Qb)
 
 
 def _search(grp: FloatGroup, method: str, F: np.ndarray, max_nodes: int, stop: float):
