@@ -11,22 +11,13 @@ Run: python benchmarks/bench_constellation.py
 """
 from __future__ import annotations
 
-import time
 import warnings
 
 import numpy as np
 
 from simkit import constellation as sc
 from simkit.constellation.sources import DATA_DIR, resolve
-
-
-def best_of(fn, repeat):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+from timing import best_of  # benchmarks/timing.py
 
 
 def bench_parse():

@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 import simkit  # noqa: E402
 from simkit import referee  # noqa: E402
 from simkit.solution import Solution  # noqa: E402
+from timing import best_of  # noqa: E402  (benchmarks/timing.py)
 
 SWAP = np.array([[0.0, 1, 0], [1, 0, 0], [0, 0, -1]])
 
@@ -36,15 +36,6 @@ def _pyins_frame(t, pos_ecef, vel_enu, quat):
     vel = vel_enu @ SWAP.T
     return pd.DataFrame({"lat": lat, "lon": lon, "alt": h, "VN": vel[:, 0], "VE": vel[:, 1], "VD": vel[:, 2],
                          "roll": rph[:, 2], "pitch": rph[:, 1], "heading": np.mod(rph[:, 0], 360)}, index=t)
-
-
-def _best(fn, repeat=3):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main(argv=None) -> int:
@@ -61,10 +52,10 @@ def main(argv=None) -> int:
     cov = np.broadcast_to(np.eye(6), (k, 6, 6)).copy()
     sol = Solution(t=mid.t, pos_ecef=mid.pos_ecef + rng.standard_normal((k, 3)), vel_enu=mid.vel_enu,
                    quat_nb=mid.quat_nb, cov=cov, state_names=("pos_e", "pos_n", "pos_u", "vel_e", "vel_n", "vel_u"))
-    ours = _best(lambda: referee.score(truth, sol))
+    ours = best_of(lambda: referee.score(truth, sol))
     est = _pyins_frame(sol.t, sol.pos_ecef, sol.vel_enu, sol.quat_nb)
     ref = _pyins_frame(truth.t, truth.pos_ecef, truth.vel_enu, truth.quat_nb)
-    peer = _best(lambda: pyins_transform.compute_state_difference(est, ref))
+    peer = best_of(lambda: pyins_transform.compute_state_difference(est, ref))
     print(f"score {k} epochs against {len(truth.t)} truth samples")
     print(f"  simkit.referee.score                     {ours * 1e3:8.1f} ms  {k / ours / 1e6:6.2f} M epochs/s")
     print(f"  pyins compute_state_difference (peer)    {peer * 1e3:8.1f} ms  {k / peer / 1e6:6.2f} M epochs/s")
