@@ -108,7 +108,7 @@ def broadcast_ionosphere(ds, p):
         return None, "none (estimator.ionosphere = none)"
     if "gnss/iono_alpha" not in ds:
         return None, f"none ({ds.path} has no /gnss/iono_alpha: written before simkit stored the broadcast model)"
-    systems = [str(x.decode() if isinstance(x, bytes) else x) for x in ds["gnss/iono_systems"][:]]
+    systems = [str(x) for x in ds["gnss/iono_systems"][:]]  # the reader returns str
     alpha, beta = ds["gnss/iono_alpha"][:], ds["gnss/iono_beta"][:]
     coef = {k: (alpha[i], beta[i]) for i, k in enumerate(systems)}
     return coef, "broadcast Klobuchar (" + ", ".join(sorted(coef)) + ") from /gnss/iono_alpha, /gnss/iono_beta"
