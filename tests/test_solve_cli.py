@@ -59,6 +59,11 @@ def test_a_resolve_replaces_only_its_own_group(small):
     (["--filter", "hinf", "--set", "estimator.alpha=abc"], "estimator.alpha: expected a number, got 'abc'"),
     (["--filter", "kf15", "--set", "estimator.p0_pos_m=[1, 2]"], "estimator.p0_pos_m: expected a list of 3"),
     (["--filter", "kf15", "--set", "estimator.cov_dt_s=0"], "estimator.cov_dt_s: expected a positive"),
+    (["--filter", "attitude", "--set", "estimator.validation=strict"], "estimator.validation: 'strict'; expected one"),
+    (["--filter", "attitude", "--set", "estimator.pf=2"], "estimator.pf: 2; expected a probability in (0, 1)"),
+    (["--filter", "attitude", "--set", "estimator.float_epochs=0"], "estimator.float_epochs: 0; expected an integer"),
+    (["--filter", "attitude", "--set", "estimator.attitude=quat"], "estimator.attitude: 'quat'; expected one of"),
+    (["--filter", "tdcp", "--set", "estimator.lever_rate=gps"], "estimator.lever_rate: 'gps'; expected one of"),
 ])
 def test_bad_arguments_fail_cleanly(small, args, expect):
     assert_clean_error(["solve", str(small), *args, "-q"], small.parent, expect=expect)

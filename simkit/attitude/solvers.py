@@ -151,10 +151,7 @@ def solver(name: str):
 
     def solve(ds, params: dict | None = None, progress: bool = False) -> Solution:
         """Attitude from the file's multi-antenna carrier phase (see docs/attitude.md)."""
-        p = merge(AMBIGUITY_DEFAULTS, params, name)
-        if p["attitude"] not in ("wls", "svd", "badshah", "baseline"):
-            raise AttitudeInputError("estimator.attitude",
-                                     f"{p['attitude']!r}; expected wls, svd, badshah or baseline")
+        p = merge(AMBIGUITY_DEFAULTS, params, name)  # checks the choices and limits of every key
         fd = read(ds, p)
         if method == "mclambda" and fd.lever_arm.shape[0] < 3:
             raise AttitudeInputError("gnss/antennas/lever_arm_b", "MC-LAMBDA needs at least 3 antennas")

@@ -71,10 +71,6 @@ def imu_centre_velocity(ds, fd, p, vel_enu, lla):
     source = p["lever_attitude"]
     if source == "auto":
         source = "attitude" if n_ant >= 3 else "none"
-    if source not in ("attitude", "truth", "none"):
-        raise AttitudeInputError("estimator.lever_attitude", f"{source!r}; expected auto, attitude, truth or none")
-    if p["lever_rate"] not in ("attitude", "imu"):
-        raise AttitudeInputError("estimator.lever_rate", f"{p['lever_rate']!r}; expected attitude or imu")
     K = len(vel_enu)
     if source == "none":
         return np.full((K, 3), np.nan), np.full((K, 3, 3), np.nan), source
