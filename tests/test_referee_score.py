@@ -183,7 +183,8 @@ def test_estimate_outside_the_truth_span_is_a_clear_error(truth):
         referee.score(truth, sol, where="est.csv")
     part = Solution(t=truth.t[-1] - 1.0 + np.arange(4.0), pos_ecef=np.tile(truth.pos_ecef[-1], (4, 1)))
     assert referee.score(truth, part).meta == {"epochs_scored": 2, "epochs_outside_truth": 2,
-                                               "t_first_s": truth.t[-1] - 1.0, "t_last_s": truth.t[-1]}
+                                               "t_first_s": truth.t[-1] - 1.0, "t_last_s": truth.t[-1],
+                                               "point": "imu", "not_estimated": ["velocity", "attitude"]}
 
 
 def test_spec_limits_pass_and_fail_with_named_quantities(truth):

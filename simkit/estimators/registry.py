@@ -142,7 +142,7 @@ def solve_spp(ds, params, progress=False) -> Solution:
     fx = spp_fixes(ds, p)
     cov = np.full((fx.t.size, 6, 6), np.nan)
     cov[:, :3, :3], cov[:, 3:, 3:] = fx.pos_cov_enu, fx.vel_cov_enu
-    return Solution(t=fx.t, pos_ecef=fx.pos_ecef, vel_enu=fx.vel_enu, cov=cov,
+    return Solution(t=fx.t, pos_ecef=fx.pos_ecef, vel_enu=fx.vel_enu, cov=cov, point=f"antenna:{int(p['antenna'])}",
                     state_names=("pos_e", "pos_n", "pos_u", "vel_e", "vel_n", "vel_u"),
                     extras={"clock": fx.clock, "n_sats": fx.n_sats},
                     extra_units={"clock": "m (one column per system: " + ",".join(fx.systems) + ")",

@@ -3,6 +3,9 @@
 A re-solve replaces only its own group: the new group is written under a temporary name in the same file and
 moved into place once complete, so an interrupted solve leaves the previous solution (and everything else)
 untouched. HDF5 does not reclaim the space of a replaced group; ``h5repack`` does.
+
+Group attributes: ``config`` (JSON) and ``point`` (the point the position and velocity belong to, see
+:mod:`simkit.solution`; a group without it, written before it existed, is read as "imu").
 """
 from __future__ import annotations
 
@@ -14,7 +17,7 @@ import h5py
 import numpy as np
 
 from ..errors import DataFileError
-from ..solution import Solution
+from ..solution import Solution, parse_point
 from . import schema
 from .reader import open_dataset
 
@@ -45,6 +48,7 @@ def write_solution(path, name: str, sol: Solution) -> None:
 
 def _fill(g: h5py.Group, name: str, sol: Solution) -> None:
     g.attrs["config"] = json.dumps(sol.config)
+    g.attrs["point"] = sol.point
     for key in _FIELDS:
         value = getattr(sol, key)
         if value is not None:
@@ -86,6 +90,12 @@ def read_solution(path, name: str) -> Solution:
         for key in ds.members(f"{prefix}/extras"):
             extras[key] = ds[f"{prefix}/extras/{key}"][()]
             units[key] = ds[f"{prefix}/extras/{key}"].units
-        config = json.loads(ds.group_attrs(prefix).get("config", "{}"))
+        attrs = ds.group_attrs(prefix)
+        config = json.loads(attrs.get("config", "{}"))
+        point = str(attrs.get("point", "imu"))
+    try:
+        parse_point(point)
+    except ValueError as exc:
+        raise DataFileError(path, f"/solutions/{name} attribute {exc}") from None
     return Solution(state_names=tuple(str(n) for n in names), extras=extras, extra_units=units, config=config,
-                    **values)
+                    point=point, **values)

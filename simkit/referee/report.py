@@ -77,7 +77,8 @@ def to_markdown(sc: Score, label: str = "", truth: str = "") -> str:
     out = [f"# Score of {label or 'estimate'}", "",
            f"Truth: {truth or '-'}; {m['epochs_scored']} epochs scored from {m['t_first_s']:.2f} s to "
            f"{m['t_last_s']:.2f} s ({m['epochs_outside_truth']} outside the truth span left out). Errors are "
-           f"estimate - truth; position and velocity in ENU.", "",
+           f"estimate - truth; position and velocity in ENU, at the point {m.get('point', 'imu')!r}.", "",
+           *([f"Not estimated (left out): {', '.join(m['not_estimated'])}.", ""] if m.get("not_estimated") else []),
            "| quantity | unit | " + " | ".join(STATS) + " |", "|---|---|" + "---:|" * len(STATS)]
     for q, row in sc.statistics.items():
         out.append(f"| {q} | {UNIT_TEXT[UNIT_OF[q]]} | " + " | ".join(_fmt(row[s]) for s in STATS) + " |")

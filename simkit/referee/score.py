@@ -26,7 +26,7 @@ class Score:
     nis: dict | None
     checks: list = field(default_factory=list)
     meta: dict = field(default_factory=dict)
-    sigmas: dict = field(default_factory=dict)
+    bands: dict = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
@@ -35,7 +35,7 @@ class Score:
 
     def as_dict(self) -> dict:
         """JSON-ready summary (no per-epoch series)."""
-        strip = (lambda d: None if d is None else {k: v for k, v in d.items() if k != "series"})
+        strip = (lambda d: None if d is None else {k: v for k, v in d.items() if k not in ("series", "dof")})
         return {"meta": self.meta, "units": {q: stats.UNIT_OF[q] for q in self.statistics},
                 "statistics": self.statistics, "convergence": self.convergence, "nees": strip(self.nees),
                 "nis": strip(self.nis), "checks": self.checks, "passed": self.passed}
@@ -47,6 +47,8 @@ def score(truth: Truth, sol: Solution, spec: Spec | None = None, where: str = "e
     spec = spec if spec is not None else Spec()
     err = compare(truth, sol, where)
     series = stats.series(err)
+    missing = stats.not_estimated(err, series)
+    series = {q: x for q, x in series.items() if q not in missing}
     table = {q: stats.statistics(x) for q, x in series.items()}
     conv = {q: {"threshold": thr, "time_s": stats.convergence_time(err.t, series[q], thr)}
             for q, (thr, _) in spec.convergence.items() if q in series}
@@ -54,12 +56,10 @@ def score(truth: Truth, sol: Solution, spec: Spec | None = None, where: str = "e
     nees = stats.nees(err, sol.cov, sol.state_names, confidence) if sol.cov is not None else None
     nis = stats.nis(err, sol.extras, confidence)
     meta = {"epochs_scored": int(err.t.size), "epochs_outside_truth": int(np.size(sol.t) - err.t.size),
-            "t_first_s": float(err.t[0]), "t_last_s": float(err.t[-1])}
-    sigmas = {}
-    if sol.cov is not None:
-        diag = np.einsum("kii->ki", np.asarray(sol.cov, dtype=float)[err.index])
-        sigmas = {name: np.sqrt(diag[:, j]) for j, name in enumerate(sol.state_names)}
-    return Score(err, table, conv, nees, nis, _checks(spec, table, conv, nees, nis), meta, sigmas)
+            "t_first_s": float(err.t[0]), "t_last_s": float(err.t[-1]), "point": sol.point,
+            "not_estimated": missing}
+    bands = stats.sigma_bands(err, sol.cov, sol.state_names) if sol.cov is not None else {}
+    return Score(err, table, conv, nees, nis, _checks(spec, table, conv, nees, nis), meta, bands)
 
 
 def _check(name, value, limit, passed):

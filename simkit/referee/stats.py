@@ -10,12 +10,21 @@ is chi-square with n degrees of freedom for a consistent filter: the two-sided b
 chi2.ppf((1 -+ c) / 2, n) per epoch, and chi2.ppf((1 -+ c) / 2, K n) / K for the mean over K epochs
 (Bar-Shalom, Li & Kirubarajan 2001, sec. 5.4). NIS is tested the same way from a filter's own ``nis`` and
 ``nis_dof`` extras.
+
+At each epoch the NEES uses the recognised states that have a finite error and a finite variance there, so n is
+per epoch: a state a solution does not estimate at an epoch (a NaN block of its covariance, or a NaN error) leaves
+the test and reduces its dimension. A NaN covariance between two states that both have finite variances is taken
+as no correlation: the solution estimated them as separate blocks (SPP's position and velocity); the NEES is then
+the sum of the blocks' NEES.
 """
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
+from .. import frames
+from . import quat
 from .compare import STATE_SERIES, Errors
 
 STATS = ("rms", "mean", "std", "max", "p50", "p95", "p99")
@@ -37,6 +46,14 @@ def series(err: Errors) -> dict[str, np.ndarray]:
         out.update(zip(UNITS["deg"][:3], np.degrees(err.euler).T))
         out["attitude_3d"] = np.degrees(np.linalg.norm(err.att_enu, axis=1))
     return out
+
+
+def not_estimated(err: Errors, series_: dict) -> list[str]:
+    """What the estimate does not give, in words and quantity names: "position", "velocity", "attitude" for a
+    missing part, and each quantity whose error series has no finite value (the roll of a single baseline)."""
+    parts = [name for name, x in (("position", err.pos_enu), ("velocity", err.vel_enu), ("attitude", err.euler))
+             if x is None]
+    return parts + [q for q, x in series_.items() if not np.isfinite(x).any()]
 
 
 def statistics(x: np.ndarray) -> dict[str, float]:
@@ -70,13 +87,69 @@ def nees(err: Errors, cov: np.ndarray, state_names, confidence: float = 0.95) ->
     cols = [j for j, _ in used]
     e = np.stack([err.state(name) for _, name in used], axis=-1)
     P = np.asarray(cov, dtype=float)[np.ix_(err.index, cols, cols)]
-    ok = np.all(np.isfinite(e), axis=1) & np.all(np.isfinite(P), axis=(1, 2))
-    value = np.full(len(e), np.nan)
-    if ok.any():
-        value[ok] = np.einsum("ki,ki->k", e[ok], np.linalg.solve(P[ok], e[ok][..., None])[..., 0])
-    out = chi_square(value, np.full(len(e), len(used)), confidence)
-    out.update(states=[name for _, name in used], series=value)
+    value, dof = reduced_nees(e, P)
+    out = chi_square(value, dof, confidence)
+    out.update(states=[name for _, name in used], series=value, dof=dof)
     return out
+
+
+def reduced_nees(e: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """NEES (K,) and its dimension (K,) from errors ``e`` (K, n) and covariances ``P`` (K, n, n) over the states
+    with a finite error and variance at each epoch (NaN cross-covariances among them taken as 0, see the module
+    docstring); NaN and dimension 0 at an epoch without any such state."""
+    n = e.shape[1]
+    avail = np.isfinite(e) & np.isfinite(np.einsum("kii->ki", P))
+    both = avail[:, :, None] & avail[:, None, :]
+    # states left out get an identity row/column and a zero error: they add nothing to e^T P^-1 e
+    Pr = np.where(both, np.nan_to_num(P, nan=0.0), np.eye(n))
+    er = np.where(avail, e, 0.0)
+    dof = avail.sum(axis=1)
+    value = np.full(len(e), np.nan)
+    ok = dof > 0
+    if ok.any():
+        value[ok] = np.einsum("ki,ki->k", er[ok], np.linalg.solve(Pr[ok], er[ok][..., None])[..., 0])
+    return value, dof
+
+
+def sigma_bands(err: Errors, cov: np.ndarray, state_names) -> dict[str, np.ndarray]:
+    """Standard deviations (K, 3) of the ``pos_enu`` (m), ``vel_enu`` (m/s) and ``euler`` (rad) error series
+    that the covariance ``cov`` (K_all, X, X) implies at the scored epochs (NaN for a component it does not
+    cover): a state mapped onto one component by :meth:`Errors.factor` (pos_n, d_lat, vel_d, heading, ...)
+    gives sqrt(P_jj) / |f|; without Euler states, a full misalignment (att_* or phi_*) gives the Euler sigmas
+    through the first-order map d euler = G d att (G from the true attitude)."""
+    P = np.asarray(cov, dtype=float)[err.index]
+    var = np.einsum("kii->ki", P)
+    out = {s: np.full((len(err.t), 3), np.nan) for s in ("pos_enu", "vel_enu", "euler", "att_enu")}
+    att_cols = [None, None, None]
+    for j, name in enumerate(state_names):
+        found = err.factor(name)
+        if found is None:
+            continue
+        series_name, k, f = found
+        if np.all(np.isnan(out[series_name][:, k])):
+            out[series_name][:, k] = np.sqrt(var[:, j]) / np.abs(f)
+            if series_name == "att_enu":
+                att_cols[k] = (j, f)
+    if np.all(np.isnan(out["euler"])) and None not in att_cols and err.quat_nb is not None:
+        idx = [j for j, _ in att_cols]
+        S = np.diag([1.0 / f for _, f in att_cols])          # att = S state (f = +-1)
+        P_att = S @ P[:, idx][:, :, idx] @ S
+        G = euler_jacobian(err.quat_nb)
+        out["euler"] = np.sqrt(np.einsum("kij,kjl,kil->ki", G, P_att, G))
+    del out["att_enu"]
+    return out
+
+
+def euler_jacobian(quat_nb: np.ndarray, step: float = 1e-6) -> np.ndarray:
+    """(K, 3, 3) derivative of Euler [pitch, roll, heading] (rad) with respect to a misalignment phi (ENU, rad),
+    C = exp([phi x]) C_nb, at the attitudes ``quat_nb`` (K, 4), by central differences of ``step`` rad."""
+    cols = []
+    for axis in np.eye(3):
+        plus = quat.mul(quat.from_rotvec(step * axis), quat_nb)
+        minus = quat.mul(quat.from_rotvec(-step * axis), quat_nb)
+        d = frames.euler_from_attitude(Rotation.from_quat(plus)) - frames.euler_from_attitude(Rotation.from_quat(minus))
+        cols.append((np.mod(d + np.pi, 2 * np.pi) - np.pi) / (2 * step))
+    return np.stack(cols, axis=-1)
 
 
 def chi_square(value: np.ndarray, dof: np.ndarray, confidence: float = 0.95) -> dict:
@@ -106,4 +179,4 @@ def nis(err: Errors, extras: dict, confidence: float = 0.95) -> dict | None:
 
 
 __all__ = ["STATE_SERIES", "STATS", "UNITS", "UNIT_OF", "chi_square", "convergence_time", "nees", "nis",
-           "series", "statistics"]
+           "not_estimated", "reduced_nees", "series", "sigma_bands", "statistics"]
