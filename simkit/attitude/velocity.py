@@ -135,4 +135,5 @@ def solve_tdcp(ds, params: dict | None = None, progress: bool = False) -> Soluti
              "residual_rms": "m"}
     config = {"estimator": "tdcp", "signals": list(fd.signals), **p, "lever_attitude_used": source}
     config["stop_s"] = None if np.isinf(p["stop_s"]) else p["stop_s"]
-    return Solution(t=0.5 * (fd.t[1:] + fd.t[:-1]), extras=extras, extra_units=units, config=config)
+    return Solution(t=0.5 * (fd.t[1:] + fd.t[:-1]), extras=extras, extra_units=units, config=config,
+                    vel_enu=vel_enu, cov=cov_ant, state_names=("vel_e", "vel_n", "vel_u"), point=f"antenna:{ant}")

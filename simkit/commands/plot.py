@@ -21,7 +21,7 @@ def run(args) -> int:
     from tqdm import tqdm
 
     from ..io import open_dataset
-    from ..plots import FIGURES, file_figures, require_matplotlib
+    from ..plots import FIGURES, file_figures, require_matplotlib, staged_directory
 
     out = Path(args.out)
     if out.exists() and not out.is_dir():
@@ -30,9 +30,8 @@ def run(args) -> int:
         raise ScenarioError("--out", f"{args.out}: directory {str(out.parent)!r} does not exist")
     require_matplotlib("simkit plot")
     open_dataset(args.file).close()
-    out.mkdir(exist_ok=True)
-    with tqdm(total=len(FIGURES), desc="plot", unit="figure", leave=False) as bar:
-        paths = file_figures(args.file, out, bar)
+    with staged_directory(out) as tmp, tqdm(total=len(FIGURES), desc="plot", unit="figure", leave=False) as bar:
+        paths = [p.relative_to(tmp) for p in file_figures(args.file, tmp, bar)]
     for p in paths:
-        print(p)
+        print(out / p)
     return 0

@@ -23,6 +23,9 @@ def add_parser(sub):
     p.add_argument("estimate", help="a simkit HDF5 file with /solutions (the same file is fine) or a CSV "
                                     "(columns: docs/referee.md)")
     p.add_argument("--solution", metavar="NAME", help="which /solutions/NAME to score (needed when several)")
+    p.add_argument("--point", metavar="POINT", help="for a CSV estimate: the point its position and velocity "
+                                                    "belong to: imu (default), antenna:K (the file's antenna K) or "
+                                                    "lever_b:[x,y,z] (body frame x right, y forward, z up, m)")
     p.add_argument("--spec", metavar="PASS.toml", help="thresholds for pass/fail (docs/referee.md)")
     p.add_argument("--json", metavar="OUT", help="write the scores as JSON")
     p.add_argument("--report", metavar="DIR", help="write report.md and error plots (needs the 'plot' extra) here")
@@ -53,7 +56,7 @@ def run(args) -> int:
         from ..plots import require_matplotlib
 
         require_matplotlib("--report")
-    sol, label = referee.load_estimate(args.estimate, args.solution, referee.file_start(args.file))
+    sol, label = referee.load_estimate(args.estimate, args.solution, referee.file_start(args.file), args.point)
     finite = np.asarray(sol.t, dtype=float)[np.isfinite(sol.t)]
     span = (finite.min(), finite.max()) if finite.size else (None, None)
     truth = referee.read_truth(args.file, *span)    # only the truth the estimate needs
@@ -63,10 +66,9 @@ def run(args) -> int:
     if args.json:
         Path(args.json).write_text(referee.to_json(sc, label))
     if args.report:
-        from ..plots import score_figures
+        from ..plots import score_figures, staged_directory
 
-        out = Path(args.report)
-        out.mkdir(exist_ok=True)
-        (out / "report.md").write_text(markdown + "".join(f"\n![{p.stem}]({p.name})\n"
-                                                          for p in score_figures(sc, out, label)))
+        with staged_directory(args.report) as out:
+            (out / "report.md").write_text(markdown + "".join(f"\n![{p.stem}]({p.name})\n"
+                                                              for p in score_figures(sc, out, label)))
     return 0 if sc.passed else 1

@@ -7,8 +7,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import frames
+from ..errors import SimkitError
 from ..io import open_dataset, solution_names
-from .common import require_matplotlib, save
+from .common import draw, require_matplotlib, skip_line
 
 MAX_POINTS = 20_000        # truth samples drawn per curve (strided beyond that)
 MAX_EPOCHS = 2_000         # GNSS epochs drawn per satellite
@@ -146,34 +147,39 @@ FIGURES = {"trajectory": _trajectory, "sky": _sky, "satellites_dop": _dops, "imu
            "observation_errors": _observations}
 
 
-def file_figures(path, out, progress=None) -> list[Path]:
+def file_figures(path, out, progress=None, on_skip=skip_line) -> list[Path]:
     """Write every overview figure that ``path`` has the data for, plus one error figure set per stored
-    solution (under ``out/solution_<name>/``); returns the PNG paths."""
+    solution (under ``out/solution_<name>/``); returns the PNG paths. A figure or solution that cannot be drawn
+    is left out with one line to ``on_skip``."""
     plt = require_matplotlib()
     out = Path(out)
     paths = []
     with open_dataset(path) as ds:
         for name, make in FIGURES.items():
-            fig = make(plt, ds)
-            if fig is not None:
-                save(fig, out / f"{name}.png")
-                paths.append(out / f"{name}.png")
+            paths.append(draw(plt, out / f"{name}.png", make, ds, on_skip=on_skip))
             if progress is not None:
                 progress.update(1)
-    return paths + _solutions(path, out)
+    return [p for p in paths if p is not None] + _solutions(path, out, on_skip)
 
 
-def _solutions(path, out) -> list[Path]:
+def _solutions(path, out, on_skip) -> list[Path]:
+    """The score figures of every stored solution against the truth at its own point."""
     from ..io import read_solution
     from ..referee import read_truth, score
     from .score_figures import score_figures
 
     paths = []
     names = solution_names(path)
-    if names:
-        truth = read_truth(path)
-        for name in names:
-            folder = out / f"solution_{name}"
-            folder.mkdir(exist_ok=True)
-            paths += score_figures(score(truth, read_solution(path, name)), folder, f"/solutions/{name}")
+    if not names:
+        return paths
+    truth = read_truth(path)
+    for name in names:
+        try:
+            sc = score(truth, read_solution(path, name), where=f"/solutions/{name}")
+        except SimkitError as exc:
+            on_skip(f"plot: skipped /solutions/{name}: {exc}")
+            continue
+        folder = out / f"solution_{name}"
+        folder.mkdir(exist_ok=True)
+        paths += score_figures(sc, folder, f"/solutions/{name}", on_skip)
     return paths

@@ -13,6 +13,9 @@ comments. Column names carry frame and unit; their order is free.
 | NIS (optional) | ``nis`` and ``nis_dof``: a filter's normalised innovation squared and its degrees of freedom (empty or 0 where no update) |
 
 The standard deviations give a diagonal covariance (states ``pos_e`` ... ``heading``) for the NEES test.
+
+The position and velocity belong to the IMU centre unless ``point`` (``simkit score --point``) says otherwise:
+"antenna:K" for a filter that reports antenna K's phase centre, or "lever_b:[x,y,z]" (body frame, m).
 """
 from __future__ import annotations
 
@@ -20,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..solution import Solution
+from ..solution import Solution, parse_point
 from .conventions import euler_from_rph, position_ecef, quat_to_simkit
 from .errors import RefereeInputError
 
@@ -126,9 +129,14 @@ def _covariance(cols, path):
     return var[:, :, None] * np.eye(len(names)), tuple(names)
 
 
-def read_csv(path, start: tuple[int, float] | None = None) -> Solution:
+def read_csv(path, start: tuple[int, float] | None = None, point: str = "imu") -> Solution:
     """A :class:`Solution` from an estimate CSV (module docstring); ``start`` (GPS week, sow) of the scenario
-    converts ``gps_week``/``gps_sow`` times."""
+    converts ``gps_week``/``gps_sow`` times; ``point`` is the point the estimate's position and velocity
+    belong to (:mod:`simkit.solution`)."""
+    try:
+        parse_point(point)
+    except ValueError as exc:
+        raise RefereeInputError("--point", str(exc).removeprefix("point: ")) from None
     path = Path(path)
     if not path.is_file():
         raise RefereeInputError(path, "no such file")
@@ -149,4 +157,4 @@ def read_csv(path, start: tuple[int, float] | None = None) -> Solution:
     nis = _group(cols, path, ["nis", "nis_dof"], "NIS")
     extras = {} if nis is None else {"nis": nis[:, 0], "nis_dof": np.nan_to_num(nis[:, 1])}
     return Solution(t=t, pos_ecef=pos, vel_enu=vel, quat_nb=quat, euler=euler, cov=cov, state_names=names,
-                    extras=extras, config={"source": str(path)})
+                    extras=extras, config={"source": str(path)}, point=point)

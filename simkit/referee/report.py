@@ -20,13 +20,17 @@ def file_start(path) -> tuple[int, float]:
         return int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"])
 
 
-def load_estimate(path, name: str | None = None, start=None) -> tuple[Solution, str]:
-    """An estimate from a simkit HDF5 file (solution ``name``, or its only one) or a CSV; returns it and a label."""
+def load_estimate(path, name: str | None = None, start=None, point: str | None = None) -> tuple[Solution, str]:
+    """An estimate from a simkit HDF5 file (solution ``name``, or its only one) or a CSV whose position and
+    velocity belong to ``point`` (default "imu"; a /solutions group declares its own); returns it and a label."""
     from .csvfile import read_csv
 
     path = Path(path)
     if path.suffix.lower() == ".csv":
-        return read_csv(path, start), path.name
+        return read_csv(path, start, point or "imu"), path.name
+    if point is not None:
+        raise RefereeInputError("--point", f"only for a CSV estimate; {path} is read as HDF5, whose "
+                                           f"/solutions group declares its own point")
     names = solution_names(path)
     if name is None:
         if len(names) != 1:
@@ -71,13 +75,20 @@ def _consistency_lines(sc: Score) -> list[str]:
     return lines or ["- no covariance or NIS in the estimate: no consistency test"]
 
 
+def _where(meta: dict) -> str:
+    """Where the position / velocity errors are taken, for the report's first lines."""
+    if {"position", "velocity"} <= set(meta.get("not_estimated", ())):
+        return ""
+    return f"; position and velocity in ENU, at the point {meta.get('point', 'imu')!r}"
+
+
 def to_markdown(sc: Score, label: str = "", truth: str = "") -> str:
     """A Markdown report: statistics table, convergence, NEES/NIS, checks and the verdict."""
     m = sc.meta
     out = [f"# Score of {label or 'estimate'}", "",
            f"Truth: {truth or '-'}; {m['epochs_scored']} epochs scored from {m['t_first_s']:.2f} s to "
            f"{m['t_last_s']:.2f} s ({m['epochs_outside_truth']} outside the truth span left out). Errors are "
-           f"estimate - truth; position and velocity in ENU, at the point {m.get('point', 'imu')!r}.", "",
+           f"estimate - truth{_where(m)}.", "",
            *([f"Not estimated (left out): {', '.join(m['not_estimated'])}.", ""] if m.get("not_estimated") else []),
            "| quantity | unit | " + " | ".join(STATS) + " |", "|---|---|" + "---:|" * len(STATS)]
     for q, row in sc.statistics.items():
