@@ -3,8 +3,10 @@ satellites and DOPs, IMU Allan deviation, observation errors, a stored solution 
 and the score figures."""
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import simkit
+import simkit.frames
 from simkit import referee
 from simkit.io import write_solution
 from simkit.plots import FIGURES
@@ -51,3 +53,68 @@ def test_plot_bad_input_is_one_clean_line(h5):
     (h5.parent / "afile").write_text("x")
     assert_clean_error(["plot", "nothere.h5", "--out", "p2"], h5.parent, expect="nothere.h5: no such file")
     assert_clean_error(["plot", h5.name, "--out", "afile"], h5.parent, expect="--out: afile exists and is not a dir")
+
+
+def test_a_failed_plot_leaves_no_folder_and_a_good_one_moves_into_place(tmp_path):
+    from simkit.plots import staged_directory
+
+    with pytest.raises(RuntimeError):
+        with staged_directory(tmp_path / "figs") as tmp:
+            (tmp / "half.png").write_bytes(PNG)
+            raise RuntimeError("drawing failed")
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "figs").mkdir()
+    (tmp_path / "figs" / "mine.txt").write_text("kept")
+    with staged_directory(tmp_path / "figs") as tmp:
+        (tmp / "sub").mkdir()
+        (tmp / "sub" / "a.png").write_bytes(PNG)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["figs"]
+    assert sorted(str(p.relative_to(tmp_path / "figs")) for p in (tmp_path / "figs").rglob("*")) == [
+        "mine.txt", "sub", "sub/a.png"]
+
+
+def test_a_figure_that_cannot_be_drawn_is_skipped_with_one_line(tmp_path):
+    from simkit.plots.common import draw, require_matplotlib
+
+    plt = require_matplotlib()
+    lines = []
+
+    def broken(plt_):
+        plt_.figure()
+        raise TypeError("cannot unpack non-iterable NoneType object")
+
+    assert draw(plt, tmp_path / "x.png", broken, on_skip=lines.append) is None
+    assert lines == ["plot: skipped x.png: TypeError: cannot unpack non-iterable NoneType object"]
+    assert not (tmp_path / "x.png").exists() and plt.get_fignums() == []
+
+
+@pytest.mark.slow   # about 4 s of matplotlib rendering
+def test_spp_like_covariance_with_nan_blocks_and_a_two_antenna_attitude_are_plotted(h5, tmp_path):
+    """The defect's two stops: the SPP covariance (NaN position-velocity blocks, NaN at epochs without a
+    velocity) and an Euler-only attitude with its roll NaN by design."""
+    from simkit.io import read_solution
+    from simkit.plots import file_figures
+
+    truth = referee.read_truth(h5)
+    k = np.arange(0, len(truth.t), 20)
+    cov = np.full((len(k), 6, 6), np.nan)
+    cov[:, :3, :3], cov[::2, 3:, 3:] = np.eye(3) * 0.04, np.eye(3) * 0.01
+    eul = simkit.frames.euler_from_attitude(Rotation.from_quat(truth.quat_nb[k]))
+    eul[:, 1] = np.nan
+    sols = {"spp_like": Solution(t=truth.t[k], pos_ecef=truth.pos_ecef[k] + 0.1, vel_enu=truth.vel_enu[k],
+                                 cov=cov, state_names=("pos_e", "pos_n", "pos_u", "vel_e", "vel_n", "vel_u")),
+            "two_antennas": Solution(t=truth.t[k], euler=eul + 0.001, cov=np.broadcast_to(
+                np.eye(2) * 1e-6, (len(k), 2, 2)).copy(), state_names=("pitch", "heading"))}
+    path = tmp_path / "q.h5"
+    path.write_bytes(h5.read_bytes())
+    for name, sol in sols.items():
+        write_solution(path, name, sol)
+    assert read_solution(path, "two_antennas").quat_nb is None
+    skipped = []
+    (tmp_path / "figs").mkdir()
+    paths = file_figures(path, tmp_path / "figs", on_skip=skipped.append)
+    assert skipped == []
+    written = {str(p.relative_to(tmp_path / "figs")) for p in paths if "solution_" in str(p)}
+    assert {"solution_spp_like/errors_position.png", "solution_spp_like/errors_velocity.png",
+            "solution_spp_like/consistency.png", "solution_two_antennas/errors_attitude.png",
+            "solution_two_antennas/consistency.png"} <= written
