@@ -118,3 +118,27 @@ def test_spp_like_covariance_with_nan_blocks_and_a_two_antenna_attitude_are_plot
     assert {"solution_spp_like/errors_position.png", "solution_spp_like/errors_velocity.png",
             "solution_spp_like/consistency.png", "solution_two_antennas/errors_attitude.png",
             "solution_two_antennas/consistency.png"} <= written
+
+
+def test_sky_plot_has_a_legend_and_its_whole_title(tmp_path, monkeypatch):
+    """``simkit sky --plot``: one legend entry per system drawn, and the title (a long source path) inside the
+    figure rather than cut at its edges."""
+    import matplotlib.figure
+
+    saved, original = [], matplotlib.figure.Figure.savefig
+
+    def capture(fig, *args, **kwargs):
+        fig.canvas.draw()
+        title = fig.axes[0].title.get_window_extent()
+        saved.append((fig.axes[0].get_legend(), title, fig.bbox))
+        return original(fig, *args, **kwargs)
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", capture)
+    out = run_cli(["sky", "--lat", "34.2", "--lon", "108.9", "--start", "2026-04-27T06:00:00Z", "--hours", "1",
+                   "--plot", "sky.png"], tmp_path)
+    assert out.returncode == 0, out.stderr
+    (legend, title, box), = saved
+    assert legend is not None
+    assert sorted(t.get_text() for t in legend.get_texts()) == ["BeiDou", "GPS"]
+    assert box.x0 <= title.x0 and title.x1 <= box.x1 and title.y1 <= box.y1
+    assert _is_png(tmp_path / "sky.png")

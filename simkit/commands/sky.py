@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -198,7 +199,7 @@ def _sky_plot(path, kind, const, geo, vis, title):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(7, 7))
+    fig = plt.figure(figsize=(8, 7), layout="constrained")
     ax = fig.add_subplot(projection="polar")
     ax.set_theta_zero_location("N")
     ax.set_theta_direction(-1)
@@ -211,7 +212,15 @@ def _sky_plot(path, kind, const, geo, vis, title):
         az, el = geo.azimuth[ok, s], np.degrees(geo.elevation[ok, s])
         ax.plot(az, el, ".", ms=3, color=colors.get(sid[0], "k"))
         ax.annotate(f"{sid} {const.orbit_type[s][0]}", (az[-1], el[-1]), fontsize=7)
-    ax.set_title(title, fontsize=9)
+    for system, name in (("G", "GPS"), ("C", "BeiDou")):   # one legend entry per system drawn
+        if any(sid[0] == system and vis[:, s].any() for s, sid in enumerate(const.sat_ids)):
+            ax.plot([], [], ".", ms=6, color=colors[system], label=name)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper left", bbox_to_anchor=(0.98, 1.0), fontsize=8,
+                  title="labels: PRN, orbit\n(M MEO, I IGSO, G GEO)", title_fontsize=7)
+    # a long source path would run off the figure: wrap it
+    ax.set_title(textwrap.fill(title, 70) + "\nazimuth clockwise from north, radius elevation [deg]", fontsize=9,
+                 pad=14)
     with atomic_open(path, "wb") as f:  # a failure never leaves a partial image under the name
-        fig.savefig(f, format=kind, dpi=120)
+        fig.savefig(f, format=kind, dpi=120, bbox_inches="tight")
     plt.close(fig)
