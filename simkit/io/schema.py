@@ -129,8 +129,9 @@ _GNSS = [
 ]
 _SOLUTIONS = [
     _f("solutions/<name>/t", "f8", ("K",), "s", "", "estimators", "solution epochs since start"),
-    _f("solutions/<name>/pos_ecef", "f8", ("K", 3), "m", "ECEF", "estimators", "estimated IMU-centre position"),
-    _f("solutions/<name>/vel_enu", "f8", ("K", 3), "m/s", "ENU", "estimators", "estimated velocity"),
+    _f("solutions/<name>/pos_ecef", "f8", ("K", 3), "m", "ECEF", "estimators",
+       "estimated position of the group's point attribute (imu, antenna:K, lever_b:[x,y,z]; imu when absent)"),
+    _f("solutions/<name>/vel_enu", "f8", ("K", 3), "m/s", "ENU", "estimators", "estimated velocity of that point"),
     _f("solutions/<name>/quat_nb", "f8", ("K", 4), "1 (x, y, z, w)", "body->ENU", "estimators", "estimated attitude"),
     _f("solutions/<name>/euler", "f8", ("K", 3), "rad", "body->ENU", "estimators", "pitch, roll, heading"),
     _f("solutions/<name>/cov", "f8", ("K", "X", "X"), "SI", "", "estimators",
