@@ -108,3 +108,15 @@ def test_filter_error_states_give_enu_and_euler_sigma_bands():
     np.testing.assert_allclose(bands["vel_enu"], np.tile([0.1, 0.2, 0.3], (n, 1)), rtol=1e-12)
     assert bands["euler"][:, 2] == pytest.approx(np.full(n, 5e-3), rel=1e-6)
     np.testing.assert_allclose(bands["euler"][:, 0] ** 2 + bands["euler"][:, 1] ** 2, 1e-6 + 4e-6, rtol=1e-6)
+
+
+def test_epochs_without_an_estimate_do_not_delay_convergence():
+    """A gap in the fixes (NaN) after the error has settled is not a divergence (SPP on error-free data used to
+    'converge' only after its last gap); an error above the threshold still counts, wherever the gaps are."""
+    t = np.arange(10.0)
+    x = np.array([5.0, 3.0, 0.5, 0.2, np.nan, np.nan, 0.1, 0.3, np.nan, 0.2])
+    assert stats.convergence_time(t, x, 1.0) == 2.0
+    assert stats.convergence_time(t, np.where(t == 7, 2.0, x), 1.0) == 9.0
+    assert stats.convergence_time(t, np.where(t == 9, 2.0, x), 1.0) is None
+    assert stats.convergence_time(t, np.where(t >= 8, np.nan, np.where(t == 7, 2.0, x)), 1.0) is None
+    assert stats.convergence_time(t, np.abs(x) * 0.1, 1.0) == 0.0

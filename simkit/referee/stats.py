@@ -70,12 +70,14 @@ def statistics(x: np.ndarray) -> dict[str, float]:
 
 def convergence_time(t: np.ndarray, x: np.ndarray, threshold: float) -> float | None:
     """Seconds from the first scored epoch until |x| stays at or below ``threshold`` for good (0 when it never
-    exceeds it, None when it still exceeds it at the last epoch)."""
-    above = np.flatnonzero(~(np.abs(x) <= threshold))
+    exceeds it, None when it still exceeds it at the last finite epoch). Epochs without an estimate (NaN) neither
+    exceed nor meet the threshold: a gap in the fixes is not a divergence."""
+    finite = np.flatnonzero(np.isfinite(x))
+    above = finite[np.abs(x[finite]) > threshold]
     if above.size == 0:
         return 0.0
-    last = above[-1]
-    return None if last == len(t) - 1 else float(t[last + 1] - t[0])
+    later = finite[finite > above[-1]]
+    return None if later.size == 0 else float(t[later[0]] - t[0])
 
 
 def nees(err: Errors, cov: np.ndarray, state_names, confidence: float = 0.95) -> dict | None:
