@@ -81,7 +81,9 @@ def _estimate_quat(sol: Solution, index: np.ndarray):
     attitude; the Euler angles as given (a NaN roll stays NaN); (None, None) without attitude."""
     if sol.quat_nb is not None:
         q = np.asarray(sol.quat_nb, dtype=float)[index]
-        ok = np.all(np.isfinite(q), axis=1) & (np.linalg.norm(q, axis=1) > 0)
+        ok = np.all(np.isfinite(q), axis=1) & np.any(q != 0, axis=1)
+        if ok.all():
+            return q, frames.euler_from_attitude(Rotation.from_quat(q))
         eul = np.full((len(index), 3), np.nan)
         if ok.any():
             eul[ok] = frames.euler_from_attitude(Rotation.from_quat(q[ok]))

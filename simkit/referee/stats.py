@@ -101,11 +101,13 @@ def reduced_nees(e: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     docstring); NaN and dimension 0 at an epoch without any such state."""
     n = e.shape[1]
     avail = np.isfinite(e) & np.isfinite(np.einsum("kii->ki", P))
-    both = avail[:, :, None] & avail[:, None, :]
-    # states left out get an identity row/column and a zero error: they add nothing to e^T P^-1 e
-    Pr = np.where(both, np.nan_to_num(P, nan=0.0), np.eye(n))
-    er = np.where(avail, e, 0.0)
     dof = avail.sum(axis=1)
+    if avail.all() and np.isfinite(P).all():     # the common case: nothing to leave out
+        Pr, er = P, e
+    else:   # states left out get an identity row/column and a zero error: they add nothing to e^T P^-1 e
+        Pr = np.where(avail[:, :, None] & avail[:, None, :], P, np.eye(n))
+        Pr[np.isnan(Pr)] = 0.0                   # what NaN is left is a cross-covariance between kept states
+        er = np.where(avail, e, 0.0)
     value = np.full(len(e), np.nan)
     ok = dof > 0
     if ok.any():
