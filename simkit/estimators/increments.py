@@ -75,32 +75,29 @@ def _rotation_term(alpha, dv):
 
 
 def _compensate(gyro_poly, accel_poly, dt, rate0):
-    """Closed-form coning / sculling (module docstring) from the (N-1, 3, 3) [a, b, c] and [p, q, r] stacks
+    """Closed-form coning / sculling (module docstring) from the (3, N-1, 3) [a, b, c] and [p, q, r] stacks
     (rad and m/s in normalised time); ``rate0`` (3,) rad/s the body rate at the first sample."""
-    a, b, c = gyro_poly[:, 0], gyro_poly[:, 1], gyro_poly[:, 2]
-    p, q, r = accel_poly[:, 0], accel_poly[:, 1], accel_poly[:, 2]
+    a, b, c = gyro_poly
+    p, q, r = accel_poly
     alpha = a + b / 2.0 + c / 3.0
     dv = p + q / 2.0 + r / 3.0
-    phi = alpha + (np.cross(a, b) + np.cross(a, c)) / 12.0 + np.cross(b, c) / 60.0
-    sculling = (np.cross(a, q) - np.cross(b, p) + np.cross(a, r) - np.cross(c, p)) / 12.0 \
-        + (np.cross(b, r) - np.cross(c, q)) / 60.0
+    phi = alpha + np.cross(a, b + c) / 12.0 + np.cross(b, c) / 60.0
+    sculling = (np.cross(a, q + r) - np.cross(b + c, p)) / 12.0 + (np.cross(b, r) - np.cross(c, q)) / 60.0
     dvb = dv + _rotation_term(alpha, dv) + sculling
     w_end = (a + b + c) / dt[:, None]
     return Compensated(phi, dvb, dt, np.vstack([rate0[None, :], w_end]))
 
 
 def _interpolate_quadratics(dt, x):
-    """(M, 3, k) polynomial coefficients [a, b, c] in normalised time of each interval i = (t[i], t[i+1]] of the
+    """(3, M, 3) polynomial coefficients [a, b, c] in normalised time of each interval i = (t[i], t[i+1]] of the
     quadratic through the samples x[i-1], x[i], x[i+1] (linear through x[i], x[i+1] for i = 0), times dt[i]:
-    the rate model of :func:`from_rates`. ``x`` (M + 1, k) samples, ``dt`` (M,) s."""
-    poly = np.zeros((dt.size, 3, x.shape[1]))
+    the rate model of :func:`from_rates`. ``x`` (M + 1, 3) samples, ``dt`` (M,) s."""
     T = dt[:, None]
     slope = x[1:] - x[:-1]                            # b + c over the interval, in units of the sample values
     curv = np.zeros_like(slope)
     u = (dt[:-1] / dt[1:])[:, None]                   # the previous sample sits at s = -u
     curv[1:] = (x[:-2] - x[1:-1] + u * slope[1:]) / (u * (1.0 + u))
-    poly[:, 0], poly[:, 1], poly[:, 2] = x[:-1] * T, (slope - curv) * T, curv * T
-    return poly
+    return np.stack([x[:-1] * T, (slope - curv) * T, curv * T])
 
 
 def from_rates(t, gyro, accel) -> Compensated:
@@ -108,31 +105,28 @@ def from_rates(t, gyro, accel) -> Compensated:
     (see module docstring)."""
     t, dt = _intervals(t)
     gyro, accel = _check("gyro", gyro, t.size), _check("accel", accel, t.size)
-    poly = _interpolate_quadratics(dt, np.concatenate([gyro, accel], axis=1))
-    return _compensate(poly[:, :, :3], poly[:, :, 3:], dt, gyro[0])
+    return _compensate(_interpolate_quadratics(dt, gyro), _interpolate_quadratics(dt, accel), dt, gyro[0])
 
 
 def _fit_quadratics(dt, inc):
-    """(M, 3, k) polynomial coefficients [a, b, c] in normalised time of each interval i whose integrals over the
+    """(3, M, 3) polynomial coefficients [a, b, c] in normalised time of each interval i whose integrals over the
     intervals i-2, i-1, i are inc[i-2], inc[i-1], inc[i] (fewer at the start: constant for i = 0, linear for
-    i = 1). ``inc`` (M, k), ``dt`` (M,) s."""
-    m = dt.size
-    poly = np.zeros((m, 3, inc.shape[1]))
-    poly[0, 0] = inc[0]
-    if m > 1:  # linear: a + b/2 = inc[1], a - b/2 * u = inc[0] / u, u = dt[0] / dt[1] (interval 0 on [-u, 0])
-        u = dt[0] / dt[1]
-        poly[1, 1] = (inc[1] - inc[0] / u) * 2.0 / (1.0 + u)
-        poly[1, 0] = inc[1] - poly[1, 1] / 2.0
-    if m > 2:
-        # interval j spans [s0, s1] in units of dt[i] (the current one [0, 1]); its integral of a + b s + c s^2
-        # is a (s1 - s0) + b (s1^2 - s0^2) / 2 + c (s1^3 - s0^3) / 3
-        u1, u2 = dt[1:-1] / dt[2:], dt[:-2] / dt[2:]
-        edges = np.stack([-(u1 + u2), -u1, np.zeros_like(u1), np.ones_like(u1)], axis=1)
-        s0, s1 = edges[:, :3], edges[:, 1:]
-        mat = np.stack([s1 - s0, (s1**2 - s0**2) / 2.0, (s1**3 - s0**3) / 3.0], axis=2)
-        rhs = np.stack([inc[:-2], inc[1:-1], inc[2:]], axis=1)
-        poly[2:] = np.linalg.solve(mat, rhs)
-    return poly
+    i = 1). ``inc`` (M, 3), ``dt`` (M,) s.
+
+    The integral Theta(t) of the signal is the cubic through its values at the four interval ends; in Newton form
+    about t[i+1], t[i], t[i-1] its divided differences come from the increments alone (no running sum, so no
+    cancellation on long records): m = inc / dt, d2 = diff(m) / (t[i+1] - t[i-1]), d3 = diff(d2) / (t[i+1] - t[i-2]).
+    With t = t[i] + s T and u = dt[i-1] / T, Theta'(t) T = a + b s + c s^2:
+        a = T (m - d2 T - d3 T^2 u),  b = T (2 d2 T + d3 T^2 (2u - 2)),  c = 3 d3 T^3."""
+    T = dt[:, None]
+    m = inc / T
+    d2, d3 = np.zeros_like(m), np.zeros_like(m)
+    d2[1:] = (m[1:] - m[:-1]) / (dt[1:] + dt[:-1])[:, None]
+    d3[2:] = (d2[2:] - d2[1:-1]) / (dt[2:] + dt[1:-1] + dt[:-2])[:, None]
+    u = np.ones_like(T)
+    u[1:] = (dt[:-1] / dt[1:])[:, None]
+    return np.stack([T * (m - d2 * T - d3 * T**2 * u), T * (2.0 * d2 * T + d3 * T**2 * (2.0 * u - 2.0)),
+                     3.0 * d3 * T**3])
 
 
 def from_increments(t, dtheta, dvel) -> Compensated:
@@ -140,5 +134,5 @@ def from_increments(t, dtheta, dvel) -> Compensated:
     (t[k-1], t[k]] (the first row is unused). See the module docstring."""
     t, dt = _intervals(t)
     dth, dv = _check("dtheta", dtheta, t.size)[1:], _check("dvel", dvel, t.size)[1:]
-    poly = _fit_quadratics(dt, np.concatenate([dth, dv], axis=1))
-    return _compensate(poly[:, :, :3], poly[:, :, 3:], dt, poly[0, 0, :3] / dt[0])
+    gyro_poly = _fit_quadratics(dt, dth)
+    return _compensate(gyro_poly, _fit_quadratics(dt, dv), dt, gyro_poly[0, 0] / dt[0])
