@@ -52,12 +52,14 @@ def test_steady_roll_velocity_increments_are_exact(output):
 
 
 @pytest.mark.parametrize("output", ["rates", "increments"])
-def test_lever_arm_rate_is_the_rate_at_the_sample_time(output):
+@pytest.mark.parametrize("jitter", [0.0, 0.3])
+def test_lever_arm_rate_is_the_rate_at_the_sample_time(output, jitter):
     # w(t) = w0 + w1 t + w2 t^2: increments dtheta[k] = its exact integral over (t[k-1], t[k]]. The rate at t[k]
     # (what the lever-arm velocity at a GNSS epoch needs) is w(t[k]); the interval mean dtheta / T is w near
-    # t[k] - T/2, 4 mrad/s off here. Both models are exact for a quadratic rate once three intervals are in.
+    # t[k] - T/2, 4 mrad/s off here. Both models are exact for a quadratic rate once three intervals are in, also
+    # on uneven steps (jitter: each step T (1 + U(0, jitter)))
     w0, w1, w2 = np.array([0.1, -0.2, 0.3]), np.array([0.8, 2.0, -1.0]), np.array([3.0, -4.0, 5.0])
-    t = np.arange(10) * T
+    t = np.concatenate([[0.0], np.cumsum(T * (1.0 + jitter * np.random.default_rng(3).random(9)))])
     rate = w0 + np.outer(t, w1) + np.outer(t**2, w2)
     cum = np.outer(t, w0) + np.outer(t**2, w1) / 2 + np.outer(t**3, w2) / 3
     dtheta = np.vstack([rate[0] * T, np.diff(cum, axis=0)])
