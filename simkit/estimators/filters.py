@@ -164,7 +164,7 @@ class _LooselyCoupled:
             raise EstimatorInputError(f"{self.name}.run: init.t = {init.t} s is after the IMU data")
         if k0 > 0:  # start at the initial state's epoch (row k0 of increments covers the interval before it)
             imu = ImuData(imu.t[k0:], imu.gyro[k0:], imu.accel[k0:], imu.increments)
-        phi, dvb, dt = (from_increments if imu.increments else from_rates)(imu.t, imu.gyro, imu.accel)
+        comp = (from_increments if imu.increments else from_rates)(imu.t, imu.gyro, imu.accel)
         cfg, n = self.config, self.n_states
         pos0 = np.asarray(init.pos_lla, float)
         nav0 = (Rotation.from_quat(init.quat_nb).as_matrix(), np.asarray(init.vel_enu, float), pos0,
@@ -175,8 +175,8 @@ class _LooselyCoupled:
         darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p), first)
         out = loop.allocate(idx.size, n)
         att_nis, dd_nis = np.full(aarr[0].size, np.nan), np.full(darr[0].size, np.nan)
-        loop.run(phi, dvb, dt, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), garr, aarr,
-                 darr, self._mode(), float(cfg.alpha), out, att_nis, dd_nis)
+        loop.run(comp.phi, comp.dvb, comp.dt, comp.w_ib, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n),
+                 float(cfg.cov_dt), garr, aarr, darr, self._mode(), float(cfg.alpha), out, att_nis, dd_nis)
         sol = self._solution(imu.t[garr[0]], out, att_nis)
         return _with_dd(sol, garr[0], darr, dd_nis) if self.uses_dd else sol
 

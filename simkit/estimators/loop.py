@@ -76,9 +76,11 @@ def allocate(m, n):
 
 
 @njit(cache=True)
-def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_nis, dd_nis):
-    """The whole recursion. ``nav0`` = (C, v, pos, bg, ba, lever); ``gnss`` = (k (M,) sample index, z (M, 6)
-    [L, lambda, h, vE, vN, vU], R (M, 6, 6)); ``att`` = (k (K,), z (K, 3), R (K, 3, 3)); ``dd`` = (k (D,),
+def run(phi, dvb, dt, w_ib, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_nis, dd_nis):
+    """The whole recursion over the compensated increments ``phi``, ``dvb``, ``dt`` of each interval and the body
+    rate ``w_ib`` (N, 3) rad/s at each sample time (:class:`.increments.Compensated`; the lever-arm velocity of a
+    fix at sample s uses w_ib[s]). ``nav0`` = (C, v, pos, bg, ba, lever); ``gnss`` = (k (M,) sample index,
+    z (M, 6) [L, lambda, h, vE, vN, vU], R (M, 6, 6)); ``att`` = (k (K,), z (K, 3), R (K, 3, 3)); ``dd`` = (k (D,),
     row offsets (D + 1,), G (T, 3), body baselines (T, 3) m, ranges (T,) m, covariance offsets (D + 1,),
     flattened covariance blocks m^2, NIS gate (D,)). Fills ``out``, ``att_nis`` (K,) and ``dd_nis`` (D,)."""
     c, v, pos, bg, ba, lever = nav0
@@ -114,7 +116,7 @@ def run(phi, dvb, dt, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_
             elif kind == 1 and d_due:
                 nu, h, r = _dd_rows(c, dd, idd, p.shape[0])
             elif kind == 2 and g_due:
-                nu, h = _pv_rows(c, v, pos, lever, ph / dt[k], gz[ig], p.shape[0])
+                nu, h = _pv_rows(c, v, pos, lever, w_ib[s] - bg, gz[ig], p.shape[0])
                 r = gr[ig]
             else:
                 continue

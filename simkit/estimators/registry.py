@@ -181,10 +181,12 @@ def gnss_fixes(ds, p) -> GnssFixes:
 
 
 def imu_data(ds) -> ImuData:
-    if "imu/gyro" in ds:
-        return ImuData(ds["imu/t"][:], ds["imu/gyro"][:], ds["imu/accel"][:])
+    # increments first: an increments file also holds /imu/gyro = dtheta / dt, the interval mean, which taken
+    # as a rate sample at t[k] lags half an interval
     if "imu/dtheta" in ds:
         return ImuData(ds["imu/t"][:], ds["imu/dtheta"][:], ds["imu/dvel"][:], increments=True)
+    if "imu/gyro" in ds:
+        return ImuData(ds["imu/t"][:], ds["imu/gyro"][:], ds["imu/accel"][:])
     raise EstimatorInputError(f"{ds.path}: no /imu/gyro or /imu/dtheta: the file has no IMU data")
 
 

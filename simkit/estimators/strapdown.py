@@ -46,12 +46,12 @@ def strapdown(t, gyro=None, accel=None, *, pos0_lla, vel0_enu, quat0_nb, dtheta=
     """
     if (gyro is None) == (dtheta is None):
         raise EstimatorInputError("strapdown: give either gyro/accel (rates) or dtheta/dvel (increments)")
-    phi, dvb, dt = from_rates(t, gyro, accel) if gyro is not None else from_increments(t, dtheta, dvel)
+    comp = from_rates(t, gyro, accel) if gyro is not None else from_increments(t, dtheta, dvel)
     pos0 = _vec("pos0_lla", pos0_lla, 3)
     v0 = _vec("vel0_enu", vel0_enu, 3)
     q0 = _vec("quat0_nb", quat0_nb, 4)
     c0 = Rotation.from_quat(q0).as_matrix()
-    cs, vs, ps = _integrate(c0, v0, pos0, phi, dvb, dt)
+    cs, vs, ps = _integrate(c0, v0, pos0, comp.phi, comp.dvb, comp.dt)
     rot = Rotation.from_matrix(cs)
     return Solution(t=np.asarray(t, float), pos_ecef=lla_to_ecef(ps[:, 0], ps[:, 1], ps[:, 2]), vel_enu=vs,
                     quat_nb=rot.as_quat(), euler=euler_from_attitude(rot),
