@@ -7,6 +7,7 @@ a filter run on simulated data is tuned to the simulated IMU unless told otherwi
 from __future__ import annotations
 
 import json
+import sys
 
 import numpy as np
 
@@ -22,7 +23,7 @@ from .spp import SppFixes, spp
 COMMON = {"gnss": "spp", "antenna": 0, "elevation_mask_deg": 10.0, "sigma_code_m": 3.0,
           "sigma_doppler_m_per_s": 0.1, "ionosphere": "broadcast", "truth_pos_sigma_m": [1.0, 1.0, 5.0], "truth_vel_sigma_m_per_s": 0.05,
           "seed": 0}
-FILTER = {"align": "motion", "align_static_s": 10.0, "init_heading_error_deg": 0.0, "p0_att_deg": [1.0, 1.0, 10.0],
+FILTER = {"align": "auto", "align_static_s": 10.0, "init_heading_error_deg": 0.0, "p0_att_deg": [1.0, 1.0, 10.0],
           "p0_vel_m_per_s": 0.5, "p0_pos_m": [5.0, 5.0, 10.0], "gyro_arw": None, "accel_vrw": None,
           "gyro_bias_rw": None, "accel_bias_rw": None, "p0_gyro_bias": None, "p0_accel_bias": None,
           "cov_dt_s": 0.1, "pos_sigma_scale": 1.0}
@@ -31,13 +32,13 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
             "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.5,
                      "lever_arm_error_m": [0.0, 0.0, 0.0], "attitude_source": "auto", "attitude_method": "attitude"},
             # the fixed DD carrier: ambiguity method, signals, elevation mask and ratio threshold of simkit.attitude
-            "kf15_dd": {**COMMON, **FILTER, "align": "auto",
+            "kf15_dd": {**COMMON, **FILTER,
                         "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
                         "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6, "dd_correlation_s": 0.0,
                         "dd_correlation_window_s": 0.0}}
 CHOICES = {"gamma_rule": ("wu", "weighted"), "ionosphere": ("broadcast", "none"),
            "dd_method": ("lambda", "clambda", "mclambda"),
-           "attitude_source": ("auto", "truth", "attitude"),
+           "attitude_source": ("auto", "attitude", "none", "truth"),
            "align": ("auto", "static", "motion", "truth", "attitude"),
            "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
 
@@ -255,9 +256,10 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes, found=None) -> InitialSt
             euler, _ = static_alignment(rates, force, lla_ant[0])
             vel = np.zeros(3)
         else:
-            moving = good[np.hypot(gnss.vel_enu[good, 0], gnss.vel_enu[good, 1]) > 5.0]
+            moving = good[np.hypot(gnss.vel_enu[good, 0], gnss.vel_enu[good, 1]) > MOTION_SPEED_M_S]
             if moving.size == 0:
-                raise EstimatorInputError("estimator.align: 'motion' needs a GNSS speed above 5 m/s; try 'static'")
+                raise EstimatorInputError(f"estimator.align: 'motion' needs a GNSS speed above {MOTION_SPEED_M_S:g} "
+                                          f"m/s, {ds.path} has none; try 'static' or 'auto'")
             g0 = moving[0]
             euler, vel = motion_alignment(gnss.vel_enu[g0]), gnss.vel_enu[g0]
             lla_ant = ecef_to_lla(gnss.pos_ecef[g0])
@@ -273,6 +275,7 @@ def initial_state(ds, p, imu: ImuData, gnss: GnssFixes, found=None) -> InitialSt
 AUTO_ATTITUDE_S = 300.0   # align = "auto" looks for a fixed attitude in the first 300 s only
 STATIC_SPEED_M_S = 0.5    # stationary start: every GNSS speed in the first align_static_s below this
 STATIC_FORCE_STD = 0.1    # and the IMU specific-force magnitude steadier than this (m/s^2, sd)
+MOTION_SPEED_M_S = 5.0    # "motion" alignment: the first GNSS fix with a horizontal speed above this
 
 
 def stationary_start(p, imu: ImuData, gnss: GnssFixes) -> bool:
@@ -289,7 +292,8 @@ def stationary_start(p, imu: ImuData, gnss: GnssFixes) -> bool:
 def resolve_align(ds, p, imu: ImuData, gnss: GnssFixes):
     """(``p['align']`` with "auto" resolved, the attitude alignment found or None): "attitude" when the file has
     3+ antennas and the attitude solver fixes an epoch with a GNSS fix in the first AUTO_ATTITUDE_S, else
-    "static" when the start is stationary (:func:`stationary_start`), else "motion"."""
+    "static" when the start is stationary (:func:`stationary_start`), else "motion" when some GNSS fix is faster
+    than MOTION_SPEED_M_S, else "static" (levelling is all that is left on a slow platform)."""
     if p["align"] != "auto":
         return p["align"], None
     good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
@@ -298,20 +302,44 @@ def resolve_align(ds, p, imu: ImuData, gnss: GnssFixes):
             return "attitude", _attitude_alignment(ds, p, gnss, good, float(gnss.t[good[0]]) + AUTO_ATTITUDE_S)
         except EstimatorInputError:
             pass
-    return ("static" if stationary_start(p, imu, gnss) else "motion"), None
+    if stationary_start(p, imu, gnss):
+        return "static", None
+    fast = np.hypot(gnss.vel_enu[good, 0], gnss.vel_enu[good, 1]) > MOTION_SPEED_M_S
+    return ("motion" if fast.any() else "static"), None
 
 
 def attitude_source(ds, p) -> str:
-    """``p['attitude_source']`` with "auto" resolved: "attitude" when the file has 3 or more antennas, else
-    "truth"; "attitude" with fewer than 3 antennas is an error naming the key."""
+    """``p['attitude_source']`` with "auto" resolved: "attitude" (simkit's own carrier-phase attitude) when the
+    file has 3 or more antennas, else "none" (no attitude updates: a default never reads the truth);
+    "attitude" with fewer than 3 antennas is an error naming the key."""
     n_ant = ds["gnss/antennas/lever_arm_b"].shape[0]
     src = p["attitude_source"]
     if src == "auto":
-        return "attitude" if n_ant >= 3 else "truth"
+        return "attitude" if n_ant >= 3 else "none"
     if src == "attitude" and n_ant < 3:
         raise EstimatorInputError(f"estimator.attitude_source: 'attitude' needs 3 or more antennas (pitch, roll "
-                                  f"and heading), {ds.path} has {n_ant}; use 'truth'")
+                                  f"and heading), {ds.path} has {n_ant}; use 'none' (or kf15_dd, whose DD "
+                                  f"update takes one baseline)")
     return src
+
+
+TRUTH_KEYS = {"gnss": "the true antenna position/velocity plus white noise as GNSS fixes",
+              "align": "the true initial position, velocity and attitude",
+              "attitude_source": "the true attitude plus white noise as GNSS attitude fixes"}
+
+
+def truth_inputs(p, att_source: str | None = None) -> list:
+    """The keys of ``p`` (with the resolved ``att_source``) whose value makes the filter read /truth; empty for
+    every default. Each is an explicit study option, warned about and recorded in the solution config."""
+    used = {"gnss": p.get("gnss"), "align": p.get("align"), "attitude_source": att_source}
+    return [k for k in TRUTH_KEYS if used[k] == "truth"]
+
+
+def warn_truth(name: str, keys: list) -> None:
+    """One stderr line naming the truth-derived inputs of filter ``name`` (nothing when ``keys`` is empty)."""
+    if keys:
+        what = "; ".join(f"estimator.{k}=truth ({TRUTH_KEYS[k]})" for k in keys)
+        print(f"warning: {name} reads /truth: {what}: a study input, not a receiver's", file=sys.stderr)
 
 
 def _solved_attitude(ds, p, solver_params: dict | None = None) -> AttitudeFixes:
@@ -323,10 +351,13 @@ def _solved_attitude(ds, p, solver_params: dict | None = None) -> AttitudeFixes:
     return AttitudeFixes(sol.t[ok], sol.euler[ok], sol.cov[ok])
 
 
-def _attitude(ds, p) -> AttitudeFixes:
-    """GNSS attitude for the 21-state filter: from the attitude solver (``attitude_source`` "attitude"), or the
-    truth at the GNSS epochs plus white noise of attitude_sigma_deg ("truth": a study input)."""
-    if attitude_source(ds, p) == "attitude":
+def _attitude(ds, p, source: str) -> AttitudeFixes | None:
+    """GNSS attitude for the 21-state filter from the resolved ``source``: the attitude solver ("attitude"),
+    none ("none"), or the truth at the GNSS epochs plus white noise of attitude_sigma_deg ("truth": a study
+    input)."""
+    if source == "none":
+        return None
+    if source == "attitude":
         return _solved_attitude(ds, p)
     t = ds["gnss/t"][:]
     k = np.clip(np.searchsorted(ds["truth/t"][:], t), 0, ds["truth/t"].shape[0] - 1)
@@ -356,14 +387,17 @@ def solve_filter(name):
 
     def solve(ds, params, progress=False) -> Solution:
         p = merged(name, params)
+        src = attitude_source(ds, p) if name == "kf21" and p["use_attitude"] else None
+        truth = truth_inputs(p, src)
+        warn_truth(name, truth)
         imu, gnss = imu_data(ds), gnss_fixes(ds, p)
         align, found = resolve_align(ds, p, imu, gnss)
         init = initial_state(ds, {**p, "align": align}, imu, gnss, found)
-        att = _attitude(ds, p) if name == "kf21" and p["use_attitude"] else None
+        att = _attitude(ds, p, src) if src is not None else None
         dd = dd_carrier(ds, p) if name == "kf15_dd" else None
         sol = cls(filter_config(ds, {**p, "align": align}, name), init).run(imu, gnss, att, dd=dd)
-        extra = {"attitude_source": attitude_source(ds, p)} if name == "kf21" and p["use_attitude"] else {}
-        extra["align_used"] = align
+        extra = {"attitude_source": src} if src is not None else {}
+        extra.update(align_used=align, truth_inputs=truth)
         if p["gnss"] == "spp":
             extra["ionosphere_correction"] = broadcast_ionosphere(ds, p)[1]
         return Solution(**{**sol.__dict__, "config": {**sol.config, "params": p, **extra}})
