@@ -118,3 +118,17 @@ def test_filters_store_their_nis_for_the_referee(solved):
     lo, hi = chi2.ppf([0.025, 0.975], 6)
     nis = sol.extras["nis"]
     assert np.mean((nis >= lo) & (nis <= hi)) >= 0.75
+
+
+def test_tdcp_lever_attitude_reads_the_truth_only_when_asked(files, capsys):
+    """``auto`` with one baseline is "none" (never the truth); "truth" is warned about and recorded."""
+    from simkit.attitude import SOLVERS as ATTITUDE
+
+    with simkit.open(files["quickstart"]) as ds:
+        auto = ATTITUDE["tdcp"](ds, {}, False)
+        assert auto.config["lever_attitude_used"] == "none" and auto.config["truth_inputs"] == []
+        assert capsys.readouterr().err == ""
+        study = ATTITUDE["tdcp"](ds, {"lever_attitude": "truth"}, False)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "warning: tdcp reads /truth: estimator.lever_attitude=truth" in err[0]
+    assert study.config["truth_inputs"] == ["lever_attitude"]

@@ -335,10 +335,12 @@ def truth_inputs(p, att_source: str | None = None) -> list:
     return [k for k in TRUTH_KEYS if used[k] == "truth"]
 
 
-def warn_truth(name: str, keys: list) -> None:
-    """One stderr line naming the truth-derived inputs of filter ``name`` (nothing when ``keys`` is empty)."""
+def warn_truth(name: str, keys: list, meaning: dict | None = None) -> None:
+    """One stderr line naming the truth-derived inputs ``keys`` of filter ``name`` (nothing when ``keys`` is
+    empty); ``meaning`` {key: what it reads} for keys other than :data:`TRUTH_KEYS` (other estimators' keys)."""
+    meaning = {**TRUTH_KEYS, **(meaning or {})}
     if keys:
-        what = "; ".join(f"estimator.{k}=truth ({TRUTH_KEYS[k]})" for k in keys)
+        what = "; ".join(f"estimator.{k}=truth ({meaning[k]})" for k in keys)
         print(f"warning: {name} reads /truth: {what}: a study input, not a receiver's", file=sys.stderr)
 
 
