@@ -12,6 +12,7 @@ import simkit
 from simkit.estimators import SOLVERS
 from simkit.io import read_solution
 from simkit.referee.score import score
+from simkit.referee.spec import parse_spec
 from simkit.referee.truth import read_truth
 
 # full length except the 24 h static site (its first 300 s: the attitude alignment and the filter's convergence)
@@ -110,7 +111,7 @@ def test_default_covariance_is_consistent_with_the_errors(solved, name, f):
     assert _nees_inside(sc, 30.0) >= 0.75, (name, f, _nees_inside(sc, 30.0))
 
 
-def test_filters_store_their_nis_for_the_referee(solved):
+def test_filters_store_their_nis_for_the_referee(solved, files):
     """Item 8: the referee's NIS test needs ``nis`` and ``nis_dof``; a spec's NIS check gave "value -"."""
     sol, sc = solved["airborne_stim300", "kf15"]
     assert set(np.unique(sol.extras["nis_dof"])) <= {0, 6}
@@ -118,6 +119,10 @@ def test_filters_store_their_nis_for_the_referee(solved):
     lo, hi = chi2.ppf([0.025, 0.975], 6)
     nis = sol.extras["nis"]
     assert np.mean((nis >= lo) & (nis <= hi)) >= 0.75
+    # the spec check now has a value (it was None, "value -", whatever the filter did)
+    spec = parse_spec({"consistency": {"nis_min_fraction_inside": 0.75}})
+    check = [c for c in score(read_truth(files["airborne_stim300"]), sol, spec).checks if c["name"].startswith("NIS")]
+    assert len(check) == 1 and check[0]["value"] is not None and check[0]["passed"]
 
 
 def test_tdcp_lever_attitude_reads_the_truth_only_when_asked(files, capsys):
