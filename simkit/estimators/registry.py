@@ -200,12 +200,25 @@ def imu_model(ds) -> dict:
     return out
 
 
+BIAS_MEMORY_S = 100.0  # the bias instability enters as the random walk that reaches its Allan floor at this tau
+
+
+def bias_walk(rate_random_walk: float, bias_instability: float) -> float:
+    """Bias random-walk density (unit/sqrt(s)) for the filter: the sensor's rate random walk K plus its bias
+    instability B (IEEE coefficient, flicker) as the random walk whose Allan deviation K' sqrt(tau/3) equals the
+    flicker floor 0.664 B at tau = BIAS_MEMORY_S. A filter with no process noise on its bias states trusts its
+    bias estimate more every hour while a flicker bias keeps wandering: on the 3 h static site kf21's height
+    error was 2.8 m RMS (SPP fixes: 1.3 m) and 23 % of its NEES inside the bounds; with this term 0.66 m, 88 %."""
+    return float(np.hypot(rate_random_walk, 0.664 * bias_instability * np.sqrt(3.0 / BIAS_MEMORY_S)))
+
+
 def filter_config(ds, p, name) -> FilterConfig:
     m = imu_model(ds)
     pick = lambda key, default: float(p[key]) if p[key] is not None else float(default)  # noqa: E731
     return FilterConfig(
         gyro_arw=pick("gyro_arw", max(m["gyro"][0], 1e-7)), accel_vrw=pick("accel_vrw", max(m["accel"][0], 1e-6)),
-        gyro_bias_rw=pick("gyro_bias_rw", m["gyro"][2]), accel_bias_rw=pick("accel_bias_rw", m["accel"][2]),
+        gyro_bias_rw=pick("gyro_bias_rw", bias_walk(m["gyro"][2], m["gyro"][3])),
+        accel_bias_rw=pick("accel_bias_rw", bias_walk(m["accel"][2], m["accel"][3])),
         p0_gyro_bias=pick("p0_gyro_bias", max(m["gyro"][1] + m["gyro"][3], 1e-7)),
         p0_accel_bias=pick("p0_accel_bias", max(m["accel"][1] + m["accel"][3], 1e-5)),
         p0_att=tuple(np.radians(np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3))),
