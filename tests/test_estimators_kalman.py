@@ -64,3 +64,33 @@ def test_violated_existence_raises_gamma_and_says_so():
 def test_non_positive_definite_innovation_is_flagged():
     out = kalman.correct(np.zeros(2), np.eye(2), np.ones(1), np.array([[1.0, 0.0]]), np.array([[-2.0]]))
     assert out[4] == kalman.STATUS_S_NOT_PD and np.isnan(out[2])
+
+
+def test_hinf_does_not_accept_a_nearly_singular_update():
+    # issue 19 item 10: p = 1, r = 1e4, alpha = 2 gives Wu's theta = (1 + p) / (alpha p) = 1 and an existence
+    # margin 1/p - theta + 1/r = 1e-4 > 0: the condition passes, but P+ = 1 / 1e-4 = 1e4 (10,000 times P).
+    # The Kalman posterior is P_kf = 1 / (1/p + 1/r); the weighted rule keeps P+ <= alpha / (alpha - 1) P_kf.
+    p, r, alpha = 1.0, 1e4, 2.0
+    x, p_new, nis, w, gamma, margin, status = kalman.correct_hinf(np.zeros(1), np.array([[p]]), np.array([1.0]),
+                                                                  np.eye(1), np.array([[r]]), alpha)
+    p_kf = 1.0 / (1.0 / p + 1.0 / r)
+    theta = 1.0 / (alpha * p_kf)  # the weighted rule, closed form for n = m = 1
+    assert status == kalman.STATUS_GAMMA_RAISED
+    assert gamma == pytest.approx(theta ** -0.5, rel=1e-12)
+    assert p_new[0, 0] == pytest.approx(1.0 / (1.0 / p - theta + 1.0 / r), rel=1e-12)
+    assert p_new[0, 0] <= alpha / (alpha - 1) * p_kf * (1 + 1e-12)
+    assert x[0] == pytest.approx(p_new[0, 0] / r, rel=1e-12)  # K nu with nu = 1
+
+
+def test_hinf_margin_is_at_least_one_minus_one_over_alpha_on_random_problems():
+    # the normalised existence matrix I - theta M^-1/2 L^T L M^-1/2 (M = I + (HL)^T R^-1 HL) has eigenvalues
+    # 1 - theta eig(P_kf) >= 1 - 1/alpha under either rule: P+ never exceeds alpha / (alpha - 1) P_kf
+    for seed in range(20):
+        x, p, z, h, r = _problem(seed)
+        r = r * 10.0 ** (seed % 5)  # measurement sigmas from 0.3 to 140 (in units where Wu's H^T H misleads)
+        nu = z - h @ x
+        p_kf = kalman.correct(x, p, nu, h, r)[1]
+        hf = kalman.correct_hinf(x, p, nu, h, r, 10.0)
+        l = np.linalg.cholesky(p_kf)
+        grow = np.linalg.eigvalsh(np.linalg.solve(l, np.linalg.solve(l, hf[1]).T))
+        assert grow.max() <= 10.0 / 9.0 * (1 + 1e-8) and grow.min() >= 1 - 1e-8

@@ -4,7 +4,8 @@ Each has ``run(imu, gnss, attitude=None) -> Solution`` on numpy arrays (``ImuDat
 ``AttitudeFixes``), no file involved. The solution has one epoch per GNSS fix used (after its update): IMU-centre
 position, velocity, attitude, the error-state covariance (``cov``, in the order of ``state_names``, SI units:
 rad, m/s, rad, rad, m, rad/s, m/s^2, m), and extras: ``gyro_bias`` (rad/s), ``accel_bias`` (m/s^2),
-``lever_arm`` (m), ``nis`` and ``innovation_std`` (standardised position/velocity innovations), ``status``,
+``lever_arm`` (m), ``nis`` with ``nis_dof`` (6; 0 where the update was skipped: the referee's NIS test) and
+``innovation_std`` (standardised position/velocity innovations), ``status``,
 and for H-infinity ``gamma`` and ``existence_margin`` (smallest eigenvalue of the existence matrix in the
 congruent form L^T (P^-1 - theta I + H^T R^-1 H) L, P = L L^T: dimensionless, positive whenever it exists).
 """
@@ -191,11 +192,14 @@ class _LooselyCoupled:
         c, v, pos, cov, bias, lever, gamma, margin, nis, w, status = out
         rot = Rotation.from_matrix(c)
         extras = {"gyro_bias": bias[:, :3], "accel_bias": bias[:, 3:], "lever_arm": lever, "nis": nis,
+                  "nis_dof": np.where(np.isfinite(nis), w.shape[1], 0).astype(np.int32),
                   "innovation_std": w, "status": status}
-        units = {"gyro_bias": "rad/s", "accel_bias": "m/s^2", "lever_arm": "m", "nis": "1",
+        units = {"gyro_bias": "rad/s", "accel_bias": "m/s^2", "lever_arm": "m",
+                 "nis": "1 (NIS of the position/velocity update at this epoch, chi-square with nis_dof dof)",
+                 "nis_dof": "1 (rows of that update: 6; 0 where it was skipped)",
                  "innovation_std": "1",
-                 "status": "0 ok, 1 gamma raised (Wu's rule violated the existence condition), "
-                           "2 S not positive definite (update skipped)"}
+                 "status": "0 ok, 1 gamma raised to the weighted rule (Wu's rule would violate the existence "
+                           "condition or leave a margin below 1 - 1/alpha), 2 S not positive definite (update skipped)"}
         if self.mode == 1:
             extras.update(gamma=gamma, existence_margin=margin)
             units.update(gamma="1", existence_margin="1 (smallest eigenvalue of L^T (P^-1 - theta I + H^T R^-1 H) L, "

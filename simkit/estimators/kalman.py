@@ -8,10 +8,13 @@ H-infinity (theta = gamma^-2):
          existence: P^-1 - theta I + H^T R^-1 H > 0 (its smallest eigenvalue is recorded as the margin);
          gamma adapts as in Wu 2015: gamma^2 = alpha * max eig((P^-1 + H^T H)^-1), alpha > 1.
          P+ = (P^-1 - theta I + H^T R^-1 H)^-1 is computed through the Cholesky factor of P (see _existence).
-         Wu's gamma uses the unweighted H^T H, so it depends on the state and measurement units: when it violates
-         the condition (e.g. a height fix of 5 m sigma, R > 1), gamma is raised to the weighted rule
-         theta = 1 / (alpha max eig((P^-1 + H^T R^-1 H)^-1)) (then halved further if ever needed), and the
-         status records it: the condition is never violated silently.
+         Wu's gamma uses the unweighted H^T H, so it depends on the state and measurement units: with R > 1 (e.g.
+         a height fix of 5 m sigma) it can violate the condition, or pass it by a hair (margin 1e-4: P and the
+         gain grow 1e4-fold in one direction, and the estimate spikes by kilometres). Wu's theta is therefore
+         used only while it is at most the weighted rule's theta = 1 / (alpha max eig((P^-1 + H^T R^-1 H)^-1))
+         (the inverse is the Kalman posterior P_kf): that keeps P+ <= alpha / (alpha - 1) P_kf, a margin of
+         1 - 1/alpha in the existence matrix normalised by I + (HL)^T R^-1 HL. Otherwise gamma is raised to the
+         weighted rule and the status records it: the condition is never violated or nearly violated silently.
 """
 from __future__ import annotations
 
@@ -21,7 +24,7 @@ import numpy as np
 from numba import njit
 
 STATUS_OK = 0
-STATUS_GAMMA_RAISED = 1      # H-infinity: the adaptive gamma violated the existence condition; gamma was raised
+STATUS_GAMMA_RAISED = 1      # H-infinity: Wu's gamma would violate (or nearly) the existence condition; raised
 STATUS_S_NOT_PD = 2          # innovation covariance not positive definite: update skipped
 
 
@@ -130,22 +133,28 @@ def weighted_theta(p, h, r, alpha):
 def correct_hinf(x, p, nu, h, r, alpha, weighted=False):
     """H-infinity correction. Returns (x, P, nis, w, gamma, margin, status); see the module docstring. The
     margin is the smallest eigenvalue of the congruent, dimensionless form of the existence matrix. With
-    ``weighted`` the gamma rule uses H^T R^-1 H instead of Wu's H^T H (see :func:`weighted_theta`)."""
+    ``weighted`` the gamma rule uses H^T R^-1 H instead of Wu's H^T H (see :func:`weighted_theta`); without it,
+    Wu's theta is used only where it is at most the weighted theta, which bounds the growth of P over the Kalman
+    posterior by alpha / (alpha - 1) (a margin of 1 - 1/alpha). Merely existing is not enough: a margin of 1e-4
+    passes the condition but multiplies a direction of P by 1e4 and the update's gain with it."""
     l = _chol(p)
     ls = _chol(h @ p @ h.T + r)
     if l.shape[0] == 0 or ls.shape[0] == 0:
         return x, p, np.nan, np.full(nu.size, np.nan), np.nan, np.nan, STATUS_S_NOT_PD
     r_inv = chol_solve(_chol(r), np.eye(r.shape[0]))
-    theta = weighted_theta(p, h, r, alpha) if weighted else 1.0 / hinf_gamma(p, h, alpha) ** 2
-    margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
+    theta = weighted_theta(p, h, r, alpha)
     status = STATUS_OK
-    if not margin > 0.0:  # Wu's rule violated the condition: fall back to the weighted rule, then halve theta
+    if not weighted:
+        theta_wu = 1.0 / hinf_gamma(p, h, alpha) ** 2
+        if theta_wu <= theta:
+            theta = theta_wu
+        else:  # Wu's rule would leave the update (nearly) singular: the weighted rule's margin instead
+            status = STATUS_GAMMA_RAISED
+    margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
+    while not margin > 0.0 and theta > 1e-300:  # rounding only: the weighted rule keeps margin >= 1 - 1/alpha
         status = STATUS_GAMMA_RAISED
-        theta = weighted_theta(p, h, r, alpha)
+        theta *= 0.5
         margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
-        while not margin > 0.0 and theta > 1e-300:
-            theta *= 0.5
-            margin = np.linalg.eigvalsh(_existence(l, h, r_inv, theta))[0]
     e = _existence(l, h, r_inv, theta)
     p_new = l @ chol_solve(_chol(e), l.T.copy())
     p_new = 0.5 * (p_new + p_new.T)
