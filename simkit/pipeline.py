@@ -45,8 +45,9 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
     :func:`simkit.io.writer.compression_threads`).
 
     Everything that can be checked is checked before the first sample: the scenario, the constellation sources
-    and their coverage of the run, the output path, and the output size (refused above the free disk space or
-    :data:`MAX_OUTPUT_BYTES` unless ``force``).
+    and their coverage of the run, the output path (an existing file is replaced only when it is a simkit file
+    without /solutions), and the output size (refused above the free disk space or :data:`MAX_OUTPUT_BYTES`);
+    ``force`` overrides the last two.
     """
     sc = load(scenario, overrides, seed=seed)
     out = Path(out) if out is not None else Path(f"{sc.name}.h5")
@@ -56,7 +57,7 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
         raise OutputError(out, f"the run would write about {size / 2**30:.0f} GiB (limit {MAX_OUTPUT_BYTES / 2**30:.0f}"
                           f" GiB; scenario.duration_s = {sc.duration_s:g}); --force to run it anyway")
     source = None if isinstance(scenario, dict) else _scenario_file(scenario)
-    check_output(out, inputs=[source], estimated_bytes=size, force=force)
+    check_output(out, inputs=[source], estimated_bytes=size, force=force, simkit_only=True)
     stages = build(sc, sky)
     with Writer(out, root_attributes(sc), threads) as w:
         _write(w, sc, stages, block_samples, progress)

@@ -104,7 +104,7 @@ def test_campaign_bad_input_is_one_clean_line(tmp_path, monkeypatch):
     assert_clean_error(base + ["--runs", "2", "--grid", "imu.bogus=1,2"], tmp_path, expect="imu.bogus: unknown key")
     assert_clean_error(base + ["--runs", "2", "--metric", "nees"], tmp_path, expect="unknown metric 'nees'")
     assert_clean_error(base + ["--runs", "2", "--workers", "0"], tmp_path, expect="--workers: expected a positive")
-    assert_clean_error(["campaign", "quickstart", "--runs", "2", "-o", "afile"], tmp_path, expect="afile: is a file")
+    assert_clean_error(["campaign", "quickstart", "--runs", "2", "-o", "afile"], tmp_path, expect="afile: exists and is not a folder")
     assert_clean_error(["campaign", "nosuch.toml", "--runs", "2", "-o", "out"], tmp_path, expect="SCENARIO")
     assert_clean_error(base, tmp_path, expect="--runs")
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 0.5)

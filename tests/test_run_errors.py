@@ -6,7 +6,7 @@ from pathlib import Path
 import h5py
 import pytest
 
-from cli_errors import assert_clean_error
+from cli_errors import assert_clean_error, digest, run_cli
 
 GOOD = """[scenario]
 name = "tiny"
@@ -90,11 +90,64 @@ def test_run_missing_scenario(tmp_path):
 @pytest.mark.parametrize("out,expect", [
     ("missing_dir/out.h5", "folder missing_dir does not exist"),
     (".", "is a directory"),
-    ("s.toml", "is an input of this run"),
+    ("s.toml", "is an input of this command"),
 ])
 def test_run_bad_output_paths(tmp_path, out, expect):
     _scenario(tmp_path, GOOD)
     assert_clean_error(["run", "s.toml", "-q", "-o", out], tmp_path, expect)
+
+
+def _foreign(path: Path) -> None:
+    with h5py.File(path, "w") as f:
+        f["x"] = 1
+
+
+def _solved(path: Path) -> None:
+    """A simkit file holding /solutions: results a re-run must not wipe."""
+    import simkit
+    from simkit.io import write_solution
+    from simkit.solution import Solution
+
+    simkit.run("quickstart", out=path, overrides=["scenario.duration_s=2"])
+    write_solution(path, "mine", Solution(t=[0.0, 1.0], pos_ecef=[[6.4e6, 0, 0]] * 2))
+
+
+@pytest.mark.parametrize("name, make, expect", [
+    ("README.md", lambda p: p.write_text("# my notes\n"), "README.md: exists and is not a simkit file"),
+    ("table.csv", lambda p: p.write_text("a,b\n1,2\n"), "table.csv: exists and is not a simkit file"),
+    ("other.h5", _foreign, "other.h5: exists and is not a simkit file"),
+    ("solved.h5", _solved, "solved.h5: exists and holds /solutions"),
+])
+def test_run_never_replaces_a_file_it_did_not_write(tmp_path, name, make, expect):
+    """issue 19 (6): `run -o` used to overwrite any file silently; now only a simkit file without /solutions
+    (what a run writes), unless --force."""
+    make(tmp_path / name)
+    before = digest(tmp_path / name)
+    assert_clean_error(["run", "quickstart", "-q", "-o", name, "--set", "scenario.duration_s=2"], tmp_path, expect)
+    assert digest(tmp_path / name) == before
+
+
+def test_run_replaces_its_own_output_and_anything_with_force(tmp_path):
+    import simkit
+
+    out = simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=2"])
+    simkit.run("quickstart", out=out, overrides=["scenario.duration_s=3"])  # a re-run of its own file
+    with simkit.open(out) as ds:
+        assert ds.duration_s("truth") == 3.0
+    (tmp_path / "README.md").write_text("# notes\n")
+    proc = run_cli(["run", "quickstart", "-q", "-o", "README.md", "--force", "--set", "scenario.duration_s=2"],
+                   tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert h5py.is_hdf5(tmp_path / "README.md")
+
+
+def test_rinex_name_stays_in_its_folder(tmp_path):
+    """issue 19 (6): `rinex --name ../evil` wrote outside its folder."""
+    import simkit
+
+    simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=2"])
+    for name in ("../evil", "sub/x", "..", ".hidden"):
+        assert_clean_error(["rinex", "q.h5", "-o", "r", "--name", name], tmp_path, "--name: expected a plain")
 
 
 def test_run_output_below_a_file(tmp_path):

@@ -100,12 +100,9 @@ def _bar(total: int, progress: bool):
 def check_dir(out_dir) -> Path:
     """The campaign directory ``DIR`` (not created here): a clear error when it is a file or its parent is
     missing. Absolute, since workers run in other folders (or on other machines sharing the file system)."""
-    out = Path(out_dir).absolute()
-    if out.exists() and not out.is_dir():
-        raise CampaignInputError("-o", f"{out}: is a file, expected a directory for the campaign")
-    if not out.parent.is_dir():
-        raise CampaignInputError("-o", f"{out}: the parent folder {out.parent} does not exist")
-    return out
+    from ..io.output import check_output
+
+    return check_output(Path(out_dir).absolute(), option="-o", folder=True)
 
 
 def run_campaign(scenario, out_dir, runs: int, grid=(), overrides=(), first_seed: int = 0, workers=None,
