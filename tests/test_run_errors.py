@@ -198,3 +198,25 @@ def test_rinex_of_a_file_without_gnss(tmp_path):
 def test_unknown_command_and_option(tmp_path):
     assert_clean_error(["frobnicate"], tmp_path, "invalid choice")
     assert_clean_error(["run", "quickstart", "--colour"], tmp_path, "unrecognized arguments")
+
+
+def test_run_takes_overrides_as_a_dict(tmp_path):
+    """issue 19 (9): simkit.run(overrides=dict) failed with a command-line-worded error. A dict (dotted keys or
+    nested tables) gives the same file as the --set strings."""
+    import numpy as np
+
+    import simkit
+    from simkit.errors import ScenarioError
+
+    a = simkit.run("quickstart", out=tmp_path / "a.h5", overrides=["scenario.duration_s=2", 'imu.preset="ideal"'])
+    b = simkit.run("quickstart", out=tmp_path / "b.h5", overrides={"scenario.duration_s": 2, "imu": {"preset": "ideal"}})
+    with simkit.open(a) as da, simkit.open(b) as db:
+        assert db.duration_s("truth") == 2.0 and db.group_attrs("imu", decode_json=True)["preset"] == "ideal"
+        assert da.attrs["scenario_toml"] == db.attrs["scenario_toml"]
+        for name, arr in da.datasets():
+            assert np.array_equal(arr[:], db[name][:], equal_nan=arr.dtype.kind == "f"), name
+    with pytest.raises(ScenarioError, match="scenario.duration_s: expected a TOML value"):
+        simkit.run("quickstart", out=tmp_path / "c.h5", overrides={"scenario.duration_s": None})
+    with pytest.raises(ScenarioError, match="overrides: expected a dict"):
+        simkit.run("quickstart", out=tmp_path / "c.h5", overrides="scenario.duration_s=2")
+    assert not (tmp_path / "c.h5").exists()

@@ -15,13 +15,14 @@ import time
 import uuid
 from pathlib import Path
 
+from ..errors import SimkitError
 from ..version import __version__
 from .aggregate import run_table, summarise
 from .errors import CampaignInputError
 from .metrics import DEFAULT_METRICS, get
 from .plan import RunSpec, expected_text, parse_grid, plan
 from .index import write_index
-from .records import read_record, record_path, verify, write_json_atomic
+from .records import file_digest, file_identity, read_record, record_path, verify, write_json_atomic
 from .task import execute, failed_record
 
 SUMMARY_VERSION = 1
@@ -86,6 +87,27 @@ def triage(specs, run_dir: Path, metric_names) -> tuple[dict, list]:
     return done, todo
 
 
+def refuse_other_settings(specs, run_dir: Path) -> None:
+    """A completed run in ``run_dir`` under a planned run's name that belongs to other settings (its record has
+    another seed or --set/--grid, or its intact file another effective scenario) is refused before anything is
+    written: a re-run would replace it. A file that differs from its own record (tampered, swapped) is not a
+    campaign's result and is run again, as before."""
+    for spec in specs:
+        rec, h5 = read_record(record_path(run_dir, spec.run_id)), run_dir / f"{spec.run_id}.h5"
+        if rec is None or rec.get("status") != "ok" or not h5.is_file():
+            continue
+        other = str(rec.get("seed")) != str(spec.seed) or list(rec.get("overrides", [])) != list(spec.overrides)
+        if not other:
+            try:
+                other = file_identity(h5)[0] != expected_text(spec) and file_digest(h5) == rec.get("sha256")
+            except SimkitError:
+                continue  # unreadable: an incomplete run, run again as before
+        if other:
+            raise CampaignInputError("-o", f"{run_dir.parent}: holds a campaign with other settings (run "
+                                     f"{spec.run_id} has another scenario, --set, --grid or seed); use another "
+                                     "folder, or remove that one")
+
+
 def _collect(client, todo, run_dir: Path, metric_names, progress: bool) -> dict:
     from distributed import as_completed
 
@@ -141,6 +163,7 @@ def run_campaign(scenario, out_dir, runs: int, grid=(), overrides=(), first_seed
         get(name)
     specs = plan(scenario, runs, grid, first_seed, overrides)
     out = check_dir(out_dir)
+    refuse_other_settings(specs, out / "runs")
     done, todo = triage(specs, out / "runs", metrics)
     records = dict(done)
     if todo:
