@@ -1,6 +1,7 @@
 """Bad input to ``simkit run``, ``inspect`` and ``rinex``: one line on stderr naming the file / key and what was
 expected, exit code 2, no traceback, nothing left on disk."""
 import os
+import sys
 from pathlib import Path
 
 import h5py
@@ -209,7 +210,8 @@ def test_run_takes_overrides_as_a_dict(tmp_path):
     from simkit.errors import ScenarioError
 
     a = simkit.run("quickstart", out=tmp_path / "a.h5", overrides=["scenario.duration_s=2", 'imu.preset="ideal"'])
-    b = simkit.run("quickstart", out=tmp_path / "b.h5", overrides={"scenario.duration_s": 2, "imu": {"preset": "ideal"}})
+    b = simkit.run("quickstart", out=tmp_path / "b.h5",
+                   overrides={"scenario.duration_s": 2, "imu": {"preset": "ideal"}})
     with simkit.open(a) as da, simkit.open(b) as db:
         assert db.duration_s("truth") == 2.0 and db.group_attrs("imu", decode_json=True)["preset"] == "ideal"
         assert da.attrs["scenario_toml"] == db.attrs["scenario_toml"]
@@ -220,3 +222,30 @@ def test_run_takes_overrides_as_a_dict(tmp_path):
     with pytest.raises(ScenarioError, match="overrides: expected a dict"):
         simkit.run("quickstart", out=tmp_path / "c.h5", overrides="scenario.duration_s=2")
     assert not (tmp_path / "c.h5").exists()
+
+
+def test_an_error_inside_a_progress_bar_starts_its_own_line(tmp_path, monkeypatch):
+    """issue 19 (9): errors were printed on the progress bar's line ("solve:  50%|#####  | 1/2 simkit solve:
+    error: ..."). The bar is cleared first: the error line's text after the last carriage return is the error."""
+    import contextlib
+    import io
+
+    from tqdm import tqdm
+
+    import simkit.commands.inspect as inspect_cmd
+    from simkit.cli import main
+    from simkit.errors import DataFileError
+
+    def stops_midway(args):
+        bar = tqdm(total=2, desc="inspect", file=sys.stderr, leave=False, mininterval=0)
+        bar.update()
+        raise DataFileError(args.file, "broken halfway")
+
+    monkeypatch.setattr(inspect_cmd, "run", stops_midway)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert main(["inspect", "x.h5"]) == 2
+    text = err.getvalue()
+    assert "1/2" in text  # the bar was drawn
+    last = text.rstrip("\n").split("\n")[-1]
+    assert last.split("\r")[-1] == "simkit inspect: error: x.h5: broken halfway", repr(text)
