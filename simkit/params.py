@@ -219,11 +219,11 @@ def merge(defaults: dict, params: dict | None, solver: str, error: Callable = _e
 
 
 def check_against_file(params: dict, defaults: dict, n_antennas: int, path, error: Callable = _error) -> None:
-    """What the file decides: an antenna index below ``n_antennas``, and the antenna count a value needs
-    (``align = "attitude"`` needs 3)."""
+    """What the file decides: an antenna index below ``n_antennas`` (a file without antennas is left to the
+    filter), and the antenna count a value needs (``align = "attitude"`` needs 3)."""
     for key, value in params.items():
         p = spec(key, defaults.get(key))
-        if p.antenna_index and not 0 <= value < n_antennas:
+        if p.antenna_index and n_antennas and not 0 <= value < n_antennas:  # none: the filter says what it lacks
             raise error(f"estimator.{key}", f"expected 0 .. {n_antennas - 1} ({path} has {n_antennas} antennas), "
                                             f"got {value!r}")
         need = p.needs_antennas.get(value, 0) if p.needs_antennas else 0

@@ -198,3 +198,29 @@ def test_the_referee_reads_the_filter_states_with_their_own_definitions(small):
     cov = sol.cov[err.index][:, :9, :9]
     np.testing.assert_allclose(ours, ref[err.index][:, nav], rtol=1e-4, atol=1e-12)
     np.testing.assert_allclose(nees(ours, cov), nees(ref[err.index][:, nav], cov), rtol=1e-3)
+
+
+@pytest.mark.slow
+def test_a_cold_numba_cache_is_announced_once(small, tmp_path):
+    """issue 19 (9): the first `simkit solve` sat silent ~40 s while numba compiled. With an empty cache
+    (NUMBA_CACHE_DIR) the command says so; once the kernels are cached it does not."""
+    import os
+    import subprocess
+    import sys
+
+    from cli_errors import ROOT
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"),
+               PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
+    cold = "from simkit.commands.solve import kernels_cold; print(kernels_cold())"
+    probe = lambda: subprocess.run([sys.executable, "-c", cold], env=env, capture_output=True, text=True,  # noqa: E731
+                                   cwd=ROOT).stdout.strip()
+    solve = ["solve", str(small), "--filter", "kf15", "--name", "numba_probe", "--set", "estimator.gnss=truth",
+             "--set", "estimator.align=static"]
+    assert probe() == "True"
+    first = subprocess.run([sys.executable, "-m", "simkit", *solve], env=env, capture_output=True, text=True)
+    assert first.returncode == 0, first.stderr
+    assert "compiling the filter kernels (first run only, cached)" in first.stderr
+    assert probe() == "False"
+    again = subprocess.run([sys.executable, "-m", "simkit", *solve], env=env, capture_output=True, text=True)
+    assert again.returncode == 0 and "compiling" not in again.stderr, again.stderr

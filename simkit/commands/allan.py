@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_open
 from ..errors import DataFileError, ScenarioError
 from ..io.output import check_output
 from . import silence_stdout
@@ -119,7 +120,8 @@ def run(args) -> int:
         payload = {"file": args.file, "sensor": args.sensor, "rate_hz": 1 / dt, "units": UNITS[args.sensor],
                    "tau_s": taus.tolist(), "adev": dev.T.tolist(),
                    "fit": {axis: res.as_dict() for axis, res in results.items()}}
-        Path(args.json).write_text(json.dumps(payload, indent=2))
+        with atomic_open(args.json, "w") as f:  # never half a file
+            f.write(json.dumps(payload, indent=2))
     return 0
 
 

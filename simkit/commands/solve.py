@@ -113,13 +113,14 @@ KERNEL_FILTERS = ("kf15", "kf15_dd", "kf21", "hinf")
 
 
 def kernels_cold() -> bool:
-    """True when a numba kernel of the filter loop has no valid on-disk cache yet (its first use compiles it,
-    ~40 s of CPU). Reads numba's cache index; False when numba's layout is not the expected one."""
+    """True when a numba kernel of the filter loop (:mod:`simkit.estimators.loop`, which compiles the Kalman and
+    H-infinity kernels it calls) has no valid on-disk cache yet: its first use compiles it, ~40 s of CPU. Reads
+    numba's cache index; False when numba's layout is not the expected one."""
     from numba.core.dispatcher import Dispatcher
 
-    from ..estimators import kalman, loop
+    from ..estimators import loop
 
-    kernels = [f for m in (kalman, loop) for f in vars(m).values() if isinstance(f, Dispatcher)]
+    kernels = [f for f in vars(loop).values() if isinstance(f, Dispatcher)]
     try:
         return any(not f._cache._cache_file._load_index() for f in kernels)
     except (AttributeError, OSError):
