@@ -26,7 +26,7 @@ def test_a_quoted_test_command_selects_tests(command):
     """issue 19 (9): `pytest -s tests/test_gnss_doppler.py` ran no test (its only test is marked slow)."""
     args = [a for a in shlex.split(command)[1:] if a != "-s"]
     args = [str(p) for a in args for p in (sorted(ROOT.glob(a)) if "*" in a else [a])]  # as a shell expands them
-    proc = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", *args],
+    proc = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-p", "no:cacheprovider", *args],
                           cwd=ROOT, capture_output=True, text=True, timeout=300)
     selected = [ln for ln in proc.stdout.splitlines() if "::" in ln]
     assert proc.returncode == 0 and selected, f"{command} selects no test:\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}"
