@@ -170,6 +170,7 @@ def test_ctrl_c_on_a_campaign_is_one_line(tmp_path):
     finally:
         _, status = os.waitpid(pid, 0)
     bar = re.compile(r"^campaign:\s+\d+%")  # the progress bar's own redraws
-    lines = [ln for ln in text.replace("^C", "").replace("\r", "\n").splitlines() if ln.strip() and not bar.match(ln)]
+    plain = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", text).replace("^C", "")  # terminal attribute resets
+    lines = [ln for ln in plain.replace("\r", "\n").splitlines() if ln.strip() and not bar.match(ln)]
     assert os.waitstatus_to_exitcode(status) == 130, text
     assert lines == ["simkit campaign: interrupted"], text
