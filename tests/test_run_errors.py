@@ -149,6 +149,10 @@ def test_rinex_name_stays_in_its_folder(tmp_path):
     simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=2"])
     for name in ("../evil", "sub/x", "..", ".hidden"):
         assert_clean_error(["rinex", "q.h5", "-o", "r", "--name", name], tmp_path, "--name: expected a plain")
+    assert not list(tmp_path.parent.glob("evil*"))
+    proc = run_cli(["rinex", "q.h5", "-o", "deep/er", "--name", "mine"], tmp_path)  # -o folders are created
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(p.name for p in (tmp_path / "deep" / "er").glob("mine_*")) == ["mine_ant0.rnx", "mine_ant1.rnx"]
 
 
 def test_run_output_below_a_file(tmp_path):

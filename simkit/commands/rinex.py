@@ -22,7 +22,7 @@ def run(args) -> int:
 
     from ..io.output import check_name, check_output
 
-    out = check_output(args.out, [args.file], option="-o", folder=True)
+    out = check_output(args.out, [args.file], option="-o", folder=True, parents=True)
     check_name("--name", args.name)
     with open_dataset(args.file) as ds:
         if "gnss/t" not in ds:

@@ -15,25 +15,28 @@ from ..atomic import temporary_name
 
 
 def check_output(out, inputs=(), estimated_bytes: int = 0, force: bool = False, option: str | None = None,
-                 folder: bool = False, simkit_only: bool = False) -> Path:
+                 folder: bool = False, simkit_only: bool = False, parents: bool = False) -> Path:
     """``out`` as a Path once it is known that it can be written; :class:`OutputError` (one line naming
     ``option`` and the path) otherwise.
 
     ``inputs``: paths the command reads (the output must not be one). ``folder``: ``out`` is a folder the command
     creates or fills (``--report DIR``); else a file. ``estimated_bytes``: an upper bound of the file size, refused
     above the free space of the folder unless ``force``. ``simkit_only``: an existing file is replaced only when it
-    is a simkit file holding no /solutions (one ``simkit run`` wrote), unless ``force``.
+    is a simkit file holding no /solutions (one ``simkit run`` wrote), unless ``force``. ``parents``: the command
+    creates missing parent folders too (``rinex -o a/b``): the nearest existing one must be a writable folder.
     """
     out = Path(out)
     where = f"{option}: {out}" if option else str(out)
     parent = out.parent if str(out.parent) else Path(".")
+    if parents:  # the command creates the missing folders: the nearest existing one decides
+        parent = next(p for p in out.absolute().parents if p.exists())
     if folder:
         if out.exists() and not out.is_dir():
             raise OutputError(where, "exists and is not a folder; expected a folder to write into")
     elif out.is_dir():
         raise OutputError(where, "is a directory, expected an output file name")
     if not parent.is_dir():
-        raise OutputError(where, f"folder {parent} does not exist")
+        raise OutputError(where, f"{parent} is not a folder" if parent.exists() else f"folder {parent} does not exist")
     _not_an_input(out, inputs, where)
     if folder:
         if not os.access(out if out.is_dir() else parent, os.W_OK):
