@@ -81,19 +81,15 @@ def split_params(filters: list[str], params: dict) -> dict:
     if all(d is not None for d in declared.values()):
         for key in params:
             if key not in known:  # raises, naming the key and the keys of the first filter
-                merge(declared[filters[0]], {key: params[key]}, filters[0], _param_error)
+                merge(declared[filters[0]], {key: params[key]}, filters[0])
     shares = {}
     for name, defaults in declared.items():
         if defaults is None:
             shares[name] = {k: v for k, v in params.items() if k not in known}
         else:
             shares[name] = {k: v for k, v in params.items() if k in defaults}
-            merge(defaults, shares[name], name, _param_error)
+            merge(defaults, shares[name], name)
     return shares
-
-
-def _param_error(key: str, message: str) -> ScenarioError:
-    return ScenarioError(key, message)
 
 
 def _check_file(path, filters, shares) -> None:
@@ -105,8 +101,7 @@ def _check_file(path, filters, shares) -> None:
     for name in filters:
         defaults = defaults_of(name)
         if defaults is not None:
-            check_against_file(merge(defaults, shares[name], name, _param_error), defaults, n_ant, path,
-                               _param_error)
+            check_against_file(merge(defaults, shares[name], name), defaults, n_ant, path)
 
 
 KERNEL_FILTERS = ("kf15", "kf15_dd", "kf21", "hinf")
