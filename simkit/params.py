@@ -199,11 +199,7 @@ def _scalar(p: Param, v):
     return v
 
 
-def _error(key: str, message: str) -> Exception:
-    return ScenarioError(key, message)
-
-
-def merge(defaults: dict, params: dict | None, solver: str, error: Callable = _error) -> dict:
+def merge(defaults: dict, params: dict | None, solver: str, error: Callable = ScenarioError) -> dict:
     """``defaults`` overridden by ``params`` after checking each against the schema; ``error(key, message)``
     builds the exception (key ``estimator.<key>``): an unknown key names the solver and the known keys."""
     out = dict(defaults)
@@ -218,7 +214,7 @@ def merge(defaults: dict, params: dict | None, solver: str, error: Callable = _e
     return out
 
 
-def check_against_file(params: dict, defaults: dict, n_antennas: int, path, error: Callable = _error) -> None:
+def check_against_file(params: dict, defaults: dict, n_antennas: int, path, error: Callable = ScenarioError) -> None:
     """What the file decides: an antenna index below ``n_antennas`` (a file without antennas is left to the
     filter), and the antenna count a value needs (``align = "attitude"`` needs 3)."""
     for key, value in params.items():
