@@ -157,7 +157,7 @@ def test_rinex_name_stays_in_its_folder(tmp_path):
 
 def test_run_output_below_a_file(tmp_path):
     (tmp_path / "afile").write_text("x")
-    assert_clean_error(["run", "quickstart", "-q", "-o", "afile/x.h5"], tmp_path, "does not exist")
+    assert_clean_error(["run", "quickstart", "-q", "-o", "afile/x.h5"], tmp_path, "afile/x.h5: afile is not a folder")
 
 
 def test_run_unwritable_folder(tmp_path, monkeypatch):
