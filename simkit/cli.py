@@ -39,15 +39,25 @@ def _interrupt(signum, frame):
     raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
+def _close_bars() -> None:
+    """Close every progress bar still drawn (a command stopped inside one): the error line then starts on a clean
+    line instead of being appended to the bar's."""
+    tqdm = sys.modules.get("tqdm")
+    for bar in list(getattr(getattr(tqdm, "tqdm", None), "_instances", ())):
+        bar.close()
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
     try:
         return int(args._run(args) or 0)
     except SimkitError as exc:
+        _close_bars()
         print(f"simkit {args.command}: error: {exc}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt as exc:
+        _close_bars()
         print(f"simkit {args.command}: interrupted{f' ({exc})' if str(exc) else ''}", file=sys.stderr)
         return 130
     except BrokenPipeError:

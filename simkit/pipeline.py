@@ -45,10 +45,11 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
     :func:`simkit.io.writer.compression_threads`).
 
     Everything that can be checked is checked before the first sample: the scenario, the constellation sources
-    and their coverage of the run, the output path, and the output size (refused above the free disk space or
-    :data:`MAX_OUTPUT_BYTES` unless ``force``).
+    and their coverage of the run, the output path (an existing file is replaced only when it is a simkit file
+    without /solutions), and the output size (refused above the free disk space or :data:`MAX_OUTPUT_BYTES`);
+    ``force`` overrides the last two.
     """
-    sc = load(scenario, overrides, seed=seed)
+    sc = load(scenario, assignments(overrides), seed=seed)
     out = Path(out) if out is not None else Path(f"{sc.name}.h5")
     sky = _sky(sc) if sc.gnss is not None else None
     size = estimate_bytes(sc, len(sky.sat_ids) if sky is not None else 0)
@@ -56,11 +57,46 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
         raise OutputError(out, f"the run would write about {size / 2**30:.0f} GiB (limit {MAX_OUTPUT_BYTES / 2**30:.0f}"
                           f" GiB; scenario.duration_s = {sc.duration_s:g}); --force to run it anyway")
     source = None if isinstance(scenario, dict) else _scenario_file(scenario)
-    check_output(out, inputs=[source], estimated_bytes=size, force=force)
+    check_output(out, inputs=[source], estimated_bytes=size, force=force, simkit_only=True)
     stages = build(sc, sky)
     with Writer(out, root_attributes(sc), threads) as w:
         _write(w, sc, stages, block_samples, progress)
     return out
+
+
+def assignments(overrides) -> list[str]:
+    """``overrides`` as ``--set`` items: a list of "dotted.key=value" strings as given, or a dict of
+    {dotted.key: value} (nested dicts are tables: ``{"imu": {"preset": "ideal"}}`` is ``imu.preset``), each value
+    written as the TOML literal the command line would take."""
+    if overrides is None or isinstance(overrides, (list, tuple)):
+        return list(overrides or [])
+    if not isinstance(overrides, dict):
+        raise ScenarioError("overrides", f"expected a dict {{dotted.key: value}} or a list of 'key=value', got "
+                            f"{type(overrides).__name__}")
+    out = []
+    for key, value in overrides.items():
+        if isinstance(value, dict) and value:
+            out += assignments({f"{key}.{k}": v for k, v in value.items()})
+        else:
+            out.append(f"{key}={toml_literal(key, value)}")
+    return out
+
+
+def toml_literal(key: str, value) -> str:
+    """``value`` as a one-line TOML literal (inline tables and arrays); a value TOML cannot hold (None, an
+    object) is an error naming ``key``."""
+    import tomli_w
+
+    if isinstance(value, dict):
+        items = (f"{tomli_w.dumps({k: 0})[:-5]} = {toml_literal(key, v)}" for k, v in value.items())  # quoted keys
+        return "{ " + ", ".join(items) + " }"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(toml_literal(key, v) for v in value) + "]"
+    try:
+        return tomli_w.dumps({"v": value.item() if hasattr(value, "item") else value})[4:].rstrip("\n")
+    except TypeError:
+        raise ScenarioError(key, f"expected a TOML value (number, string, boolean, array, table), got "
+                            f"{value!r}") from None
 
 
 def build(sc: Scenario, sky: Sky | None = None) -> Stages:

@@ -7,6 +7,7 @@ needs a fresh interpreter (a shadowed module through PYTHONPATH, closed pipes, s
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import os
 import subprocess
@@ -42,6 +43,12 @@ def run_cli(args: list[str], cwd: Path, stdin: str | None = None, timeout: float
         except SystemExit as exc:  # argparse: --help, usage errors
             code = exc.code if isinstance(exc.code, int) else 1
     return Completed(int(code or 0), out.getvalue(), err.getvalue())
+
+
+def digest(path: Path) -> str:
+    """SHA-256 of a file's bytes: an input a failed command must leave exactly as it was."""
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
 
 
 def snapshot(folder: Path) -> set[str]:

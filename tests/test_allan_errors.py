@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 import pytest
 
-from cli_errors import ROOT, assert_clean_error, run_cli
+from cli_errors import ROOT, assert_clean_error, digest, run_cli
 
 RATE = 100.0
 N_WHITE = 1e-3   # rad/s^0.5: white rate noise of two-sided PSD N^2, sample std N / sqrt(dt)
@@ -58,8 +58,11 @@ CASES = [
     (lambda f: [str(f["good"]), "--gauss-markov", "40"], "--gauss-markov: at most 3"),
     (lambda f: [str(f["flat"])], "no noise to analyse"),
     (lambda f: [str(f["stuck"])], "/imu/t does not increase"),
-    (lambda f: [str(f["good"]), "--json", "nodir/out.json"], "--json: nodir/out.json: directory 'nodir' does not exist"),
-    (lambda f: [str(f["good"]), "--plot", "nodir/adev.png"], "--plot: nodir/adev.png: directory 'nodir'"),
+    (lambda f: [str(f["good"]), "--json", "nodir/out.json"], "--json: nodir/out.json: folder nodir does not exist"),
+    (lambda f: [str(f["good"]), "--plot", "nodir/adev.png"], "--plot: nodir/adev.png: folder nodir does not"),
+    # issue 19 (6): the output is never the file being read
+    (lambda f: [str(f["good"]), "--json", str(f["good"])], "is an input of this command"),
+    (lambda f: [str(f["good"]), "--plot", str(f["good"])], "is an input of this command"),
     (lambda f: [str(f["good"]), "--json", "."], "is a directory"),
     (lambda f: [str(f["good"]), "--plot", "adev.notaformat"], "unknown image format 'notaformat'"),
 ]
@@ -67,7 +70,9 @@ CASES = [
 
 @pytest.mark.parametrize("make_args,expect", CASES)
 def test_bad_input_is_one_line(files, tmp_path, make_args, expect):
+    before = digest(files["good"])
     assert_clean_error(["allan", *make_args(files)], tmp_path, expect=expect)
+    assert digest(files["good"]) == before
 
 
 def test_output_checks_come_before_any_work(files, tmp_path):

@@ -104,7 +104,8 @@ def test_campaign_bad_input_is_one_clean_line(tmp_path, monkeypatch):
     assert_clean_error(base + ["--runs", "2", "--grid", "imu.bogus=1,2"], tmp_path, expect="imu.bogus: unknown key")
     assert_clean_error(base + ["--runs", "2", "--metric", "nees"], tmp_path, expect="unknown metric 'nees'")
     assert_clean_error(base + ["--runs", "2", "--workers", "0"], tmp_path, expect="--workers: expected a positive")
-    assert_clean_error(["campaign", "quickstart", "--runs", "2", "-o", "afile"], tmp_path, expect="afile: is a file")
+    assert_clean_error(["campaign", "quickstart", "--runs", "2", "-o", "afile"], tmp_path,
+                       expect="afile: exists and is not a folder")
     assert_clean_error(["campaign", "nosuch.toml", "--runs", "2", "-o", "out"], tmp_path, expect="SCENARIO")
     assert_clean_error(base, tmp_path, expect="--runs")
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 0.5)
@@ -134,6 +135,25 @@ def test_task_adds_missing_metrics_without_rerunning_and_keeps_a_completed_run(t
         assert ds.attrs["seed"] == spec.seed
     assert triage([spec.__class__(spec.run_id, spec.scenario, 7, spec.overrides, 0)], tmp_path,
                   ("imu_errors",))[1][0][1] is None
+
+
+def test_a_folder_of_other_settings_is_refused_and_left_as_it_was(tmp_path):
+    """issue 19 (9): reusing a campaign folder with other settings overwrote its runs silently."""
+    from cli_errors import digest
+    from simkit.campaign.task import execute
+
+    over = ["scenario.duration_s=5", "trajectory.segment[0].duration_s=5"]
+    spec = plan("xian_static_bds", 1, overrides=over)[0]
+    (tmp_path / "c" / "runs").mkdir(parents=True)
+    execute(spec, str(tmp_path / "c" / "runs"), ("imu_errors",))
+    h5 = tmp_path / "c" / "runs" / f"{spec.run_id}.h5"
+    before = digest(h5)
+    args = ["campaign", "xian_static_bds", "--runs", "1", "-o", "c", "--metric", "imu_errors", "-q"]
+    longer = ["--set", "scenario.duration_s=6", "--set", "trajectory.segment[0].duration_s=6"]
+    assert_clean_error(args + longer, tmp_path, expect="c: holds a campaign with other settings (run p000_s000000")
+    assert_clean_error(args + sum((["--set", o] for o in over), []) + ["--first-seed", "0", "--grid",
+                       "imu.preset=\"ideal\""], tmp_path, expect="holds a campaign with other settings")
+    assert digest(h5) == before
 
 
 def test_index_file_holds_the_run_table_and_virtual_datasets_over_the_runs(tmp_path):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -127,3 +128,49 @@ def test_200_runs_on_two_workers_survive_a_killed_worker_and_a_rerun_skips_all(t
     s2 = run_campaign("xian_static_bds", out, runs=200, overrides=SHORT, workers=2,
                       metrics=("imu_errors", "ambiguity"))
     assert s2["counts"]["skipped"] == 200 and s2["points"] == s["points"]
+
+
+def _read_pty(fd: int, until: float) -> str:
+    """Everything the child writes to its terminal until it closes it (EIO) or ``until`` (monotonic s)."""
+    import select
+
+    chunks = []
+    while time.monotonic() < until:
+        ready, _, _ = select.select([fd], [], [], 0.5)
+        if not ready:
+            continue
+        try:
+            data = os.read(fd, 65536)
+        except OSError:  # EIO: the child closed its terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    return b"".join(chunks).decode(errors="replace")
+
+
+def test_ctrl_c_on_a_campaign_is_one_line(tmp_path):
+    """issue 19 (9): Ctrl-C in a terminal (SIGINT to the whole foreground group, workers included) printed about
+    60 lines of Dask heartbeat tracebacks from the workers; now the command alone stops, in one line, exit 130."""
+    import pty
+
+    pid, fd = pty.fork()
+    if pid == 0:  # the child: a real terminal is its controlling tty
+        os.chdir(tmp_path)
+        os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
+        os.execv(sys.executable, [sys.executable, "-m", "simkit", "campaign", "quickstart", "--runs", "4", "-o",
+                                  "c", "--set", "scenario.duration_s=900"])
+    try:
+        deadline = time.monotonic() + 90
+        while not (tmp_path / "c" / "runs").is_dir() and time.monotonic() < deadline:
+            time.sleep(0.2)
+        early = _read_pty(fd, time.monotonic() + 6)   # the workers are simulating now
+        os.write(fd, b"\x03")                          # Ctrl-C, as typed
+        text = early + _read_pty(fd, time.monotonic() + 60)
+    finally:
+        _, status = os.waitpid(pid, 0)
+    bar = re.compile(r"^campaign:\s+\d+%")  # the progress bar's own redraws
+    plain = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", text).replace("^C", "")  # terminal attribute resets
+    lines = [ln for ln in plain.replace("\r", "\n").splitlines() if ln.strip() and not bar.match(ln)]
+    assert os.waitstatus_to_exitcode(status) == 130, text
+    assert lines == ["simkit campaign: interrupted"], text

@@ -10,7 +10,7 @@ from simkit import referee
 from simkit.io import write_solution
 from simkit.solution import Solution
 
-from cli_errors import assert_clean_error, run_cli
+from cli_errors import assert_clean_error, digest, run_cli
 
 
 @pytest.fixture(scope="module")
@@ -83,9 +83,15 @@ def test_csv_in_gps_time_is_aligned_by_the_file_start(work):
     (["score", "q.h5", "q.h5", "--spec", "typo.toml"], "limits.position3d: unknown quantity (did you mean "),
     (["score", "q.h5", "q.h5", "--json", "nodir/s.json"], "--json: nodir/s.json: directory 'nodir' does not exist"),
     (["score", "est.csv", "q.h5"], "est.csv: not an HDF5 file"),
+    # issue 19 (6): an output is never an input of the same command
+    (["score", "q.h5", "q.h5", "--json", "q.h5"], "--json: q.h5: is an input of this command"),
+    (["score", "q.h5", "est.csv", "--json", "est.csv"], "--json: est.csv: is an input of this command"),
+    (["score", "q.h5", "q.h5", "--spec", "pass.toml", "--json", "pass.toml"], "--json: pass.toml: is an input"),
 ])
 def test_bad_input_is_one_clean_line(work, args, expect):
+    before = {name: digest(work / name) for name in ("q.h5", "est.csv", "pass.toml")}
     assert_clean_error(args, work, expect=expect)
+    assert {name: digest(work / name) for name in before} == before
 
 
 def test_every_new_command_has_help(work):

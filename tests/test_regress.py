@@ -51,3 +51,20 @@ def test_regress_bad_input(tmp_path):
     (tmp_path / "g.json").write_text(json.dumps({"x": {"nope": 1}}))
     assert_clean_error(["regress", "nosuch"], tmp_path, expect="nosuch: not a TOML file, a directory or a bundled")
     assert_clean_error(["regress", "--golden", "g.json"], tmp_path, expect="g.json: x: expected duration_s")
+
+
+def test_update_writes_a_user_file_and_leaves_the_bundled_one(tmp_path):
+    """issue 19 (9): `simkit regress --update` rewrote the golden file inside the installed package."""
+    from cli_errors import digest, run_cli
+    from simkit.referee import regress
+
+    before = digest(regress.GOLDEN)
+    proc = run_cli(["regress", "quickstart", "--update"], tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert digest(regress.GOLDEN) == before
+    mine = json.loads((tmp_path / "regress_golden.json").read_text())
+    bundled = regress.load_golden()
+    assert set(mine) == set(bundled)  # started from the bundled table
+    assert set(mine["quickstart"]["quantities"]) == set(bundled["quickstart"]["quantities"])
+    check = run_cli(["regress", "quickstart", "--golden", "regress_golden.json"], tmp_path)
+    assert check.returncode == 0, check.stdout + check.stderr

@@ -1,12 +1,13 @@
 """Bad input to ``simkit run``, ``inspect`` and ``rinex``: one line on stderr naming the file / key and what was
 expected, exit code 2, no traceback, nothing left on disk."""
 import os
+import sys
 from pathlib import Path
 
 import h5py
 import pytest
 
-from cli_errors import assert_clean_error
+from cli_errors import assert_clean_error, digest, run_cli
 
 GOOD = """[scenario]
 name = "tiny"
@@ -90,16 +91,73 @@ def test_run_missing_scenario(tmp_path):
 @pytest.mark.parametrize("out,expect", [
     ("missing_dir/out.h5", "folder missing_dir does not exist"),
     (".", "is a directory"),
-    ("s.toml", "is an input of this run"),
+    ("s.toml", "is an input of this command"),
 ])
 def test_run_bad_output_paths(tmp_path, out, expect):
     _scenario(tmp_path, GOOD)
     assert_clean_error(["run", "s.toml", "-q", "-o", out], tmp_path, expect)
 
 
+def _foreign(path: Path) -> None:
+    with h5py.File(path, "w") as f:
+        f["x"] = 1
+
+
+def _solved(path: Path) -> None:
+    """A simkit file holding /solutions: results a re-run must not wipe."""
+    import simkit
+    from simkit.io import write_solution
+    from simkit.solution import Solution
+
+    simkit.run("quickstart", out=path, overrides=["scenario.duration_s=2"])
+    write_solution(path, "mine", Solution(t=[0.0, 1.0], pos_ecef=[[6.4e6, 0, 0]] * 2))
+
+
+@pytest.mark.parametrize("name, make, expect", [
+    ("README.md", lambda p: p.write_text("# my notes\n"), "README.md: exists and is not a simkit file"),
+    ("table.csv", lambda p: p.write_text("a,b\n1,2\n"), "table.csv: exists and is not a simkit file"),
+    ("other.h5", _foreign, "other.h5: exists and is not a simkit file"),
+    ("solved.h5", _solved, "solved.h5: exists and holds /solutions"),
+])
+def test_run_never_replaces_a_file_it_did_not_write(tmp_path, name, make, expect):
+    """issue 19 (6): `run -o` used to overwrite any file silently; now only a simkit file without /solutions
+    (what a run writes), unless --force."""
+    make(tmp_path / name)
+    before = digest(tmp_path / name)
+    assert_clean_error(["run", "quickstart", "-q", "-o", name, "--set", "scenario.duration_s=2"], tmp_path, expect)
+    assert digest(tmp_path / name) == before
+
+
+def test_run_replaces_its_own_output_and_anything_with_force(tmp_path):
+    import simkit
+
+    out = simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=2"])
+    simkit.run("quickstart", out=out, overrides=["scenario.duration_s=3"])  # a re-run of its own file
+    with simkit.open(out) as ds:
+        assert ds.duration_s("truth") == 3.0
+    (tmp_path / "README.md").write_text("# notes\n")
+    proc = run_cli(["run", "quickstart", "-q", "-o", "README.md", "--force", "--set", "scenario.duration_s=2"],
+                   tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert h5py.is_hdf5(tmp_path / "README.md")
+
+
+def test_rinex_name_stays_in_its_folder(tmp_path):
+    """issue 19 (6): `rinex --name ../evil` wrote outside its folder."""
+    import simkit
+
+    simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=2"])
+    for name in ("../evil", "sub/x", "..", ".hidden"):
+        assert_clean_error(["rinex", "q.h5", "-o", "r", "--name", name], tmp_path, "--name: expected a plain")
+    assert not list(tmp_path.parent.glob("evil*"))
+    proc = run_cli(["rinex", "q.h5", "-o", "deep/er", "--name", "mine"], tmp_path)  # -o folders are created
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(p.name for p in (tmp_path / "deep" / "er").glob("mine_*")) == ["mine_ant0.rnx", "mine_ant1.rnx"]
+
+
 def test_run_output_below_a_file(tmp_path):
     (tmp_path / "afile").write_text("x")
-    assert_clean_error(["run", "quickstart", "-q", "-o", "afile/x.h5"], tmp_path, "does not exist")
+    assert_clean_error(["run", "quickstart", "-q", "-o", "afile/x.h5"], tmp_path, "afile/x.h5: afile is not a folder")
 
 
 def test_run_unwritable_folder(tmp_path, monkeypatch):
@@ -145,3 +203,53 @@ def test_rinex_of_a_file_without_gnss(tmp_path):
 def test_unknown_command_and_option(tmp_path):
     assert_clean_error(["frobnicate"], tmp_path, "invalid choice")
     assert_clean_error(["run", "quickstart", "--colour"], tmp_path, "unrecognized arguments")
+
+
+def test_run_takes_overrides_as_a_dict(tmp_path):
+    """issue 19 (9): simkit.run(overrides=dict) failed with a command-line-worded error. A dict (dotted keys or
+    nested tables) gives the same file as the --set strings."""
+    import numpy as np
+
+    import simkit
+    from simkit.errors import ScenarioError
+
+    a = simkit.run("quickstart", out=tmp_path / "a.h5", overrides=["scenario.duration_s=2", 'imu.preset="ideal"'])
+    b = simkit.run("quickstart", out=tmp_path / "b.h5",
+                   overrides={"scenario.duration_s": 2, "imu": {"preset": "ideal"}})
+    with simkit.open(a) as da, simkit.open(b) as db:
+        assert db.duration_s("truth") == 2.0 and db.group_attrs("imu", decode_json=True)["preset"] == "ideal"
+        assert da.attrs["scenario_toml"] == db.attrs["scenario_toml"]
+        for name, arr in da.datasets():
+            assert np.array_equal(arr[:], db[name][:], equal_nan=arr.dtype.kind == "f"), name
+    with pytest.raises(ScenarioError, match="scenario.duration_s: expected a TOML value"):
+        simkit.run("quickstart", out=tmp_path / "c.h5", overrides={"scenario.duration_s": None})
+    with pytest.raises(ScenarioError, match="overrides: expected a dict"):
+        simkit.run("quickstart", out=tmp_path / "c.h5", overrides="scenario.duration_s=2")
+    assert not (tmp_path / "c.h5").exists()
+
+
+def test_an_error_inside_a_progress_bar_starts_its_own_line(tmp_path, monkeypatch):
+    """issue 19 (9): errors were printed on the progress bar's line ("solve:  50%|#####  | 1/2 simkit solve:
+    error: ..."). The bar is cleared first: the error line's text after the last carriage return is the error."""
+    import contextlib
+    import io
+
+    from tqdm import tqdm
+
+    import simkit.commands.inspect as inspect_cmd
+    from simkit.cli import main
+    from simkit.errors import DataFileError
+
+    def stops_midway(args):
+        bar = tqdm(total=2, desc="inspect", file=sys.stderr, leave=False, mininterval=0)
+        bar.update()
+        raise DataFileError(args.file, "broken halfway")
+
+    monkeypatch.setattr(inspect_cmd, "run", stops_midway)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert main(["inspect", "x.h5"]) == 2
+    text = err.getvalue()
+    assert "1/2" in text  # the bar was drawn
+    last = text.rstrip("\n").split("\n")[-1]
+    assert last.split("\r")[-1] == "simkit inspect: error: x.h5: broken halfway", repr(text)

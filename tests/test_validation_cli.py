@@ -4,7 +4,7 @@ import json
 import pytest
 
 import simkit
-from cli_errors import assert_clean_error, run_cli
+from cli_errors import assert_clean_error, digest, run_cli
 
 SHORT = ["--set", "scenario.duration_s=600", "--set", "gnss.rate_hz=0.1", "--no-progress"]
 
@@ -58,9 +58,19 @@ def test_file_input_matches_scenario_input(tmp_path):
     (["validate", "missing.h5", "--set", "a=1"], "--set"),
     (["validate", "xian_static_bds", "--weighting", "bogus"], "--weighting"),
     (["validate", "xian_static_bds", "--systems", "G", *SHORT], "--systems: no satellite"),
+    (["validate", "xian_static_bds", "--json", "."], "--json: .: is a directory"),  # issue 19 (6): a traceback
 ])
 def test_bad_input_is_one_line(tmp_path, args, expect):
     assert_clean_error(args, tmp_path, expect=expect)
+
+
+def test_the_json_never_replaces_the_file_read(tmp_path):
+    """issue 19 (6): `validate F.h5 --json F.h5` replaced the file (truth and solutions lost)."""
+    h5 = simkit.run("quickstart", out=tmp_path / "F.h5", overrides=["scenario.duration_s=2"])
+    before = digest(h5)
+    assert_clean_error(["validate", "F.h5", "--json", "F.h5"], tmp_path, expect="--json: F.h5: is an input")
+    assert_clean_error(["validate", "F.h5", "--report", "F.h5"], tmp_path, expect="exists and is not a folder")
+    assert digest(h5) == before
 
 
 def test_single_antenna_scenario_is_refused(tmp_path):

@@ -42,10 +42,9 @@ def main(argv=None):
     p.add_argument("file")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="attitude solver parameter")
     a = p.parse_args(argv)
-    params = {}
-    for item in a.set:
-        key, _, value = item.partition("=")
-        params[key] = value
+    from ..params import parse_set
+
+    params = parse_set(a.set, prefix="")  # TOML literals, as simkit solve --set
     with open_dataset(a.file) as ds:
         print(json.dumps(ratios(ds, params), indent=1))
 

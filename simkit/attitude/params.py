@@ -1,6 +1,7 @@
 """Estimator parameters: documented defaults, overridden by ``--set estimator.key=value``; unknown keys fail."""
 from __future__ import annotations
 
+from ..params import merge as check
 from .errors import AttitudeInputError
 
 # The stochastic defaults are the simulator's own defaults (simkit.gnss.config: PLL 15 Hz, DLL 1 Hz, 0.5 chip,
@@ -51,31 +52,7 @@ TDCP_DEFAULTS = {
 }
 
 
-CHOICES = {"validation": ("ratio", "ffrt", "none"), "attitude": ("wls", "svd", "badshah", "baseline"),
-           "lever_attitude": ("auto", "attitude", "truth", "none"), "lever_rate": ("attitude", "imu")}
-LIMITS = {"pf": (lambda x: 0 < x < 1, "a probability in (0, 1)"),
-          "ffrt_samples": (lambda x: x >= 1, "a positive integer"),
-          "float_epochs": (lambda x: x >= 1, "an integer >= 1"),
-          "static": (lambda x: x in (0, 1), "0 or 1")}
-
-
 def merge(defaults: dict, params: dict | None, solver: str) -> dict:
-    """``defaults`` overridden by ``params``; values converted to the default's type, then checked against
-    :data:`CHOICES` and :data:`LIMITS`; unknown keys and bad values raise naming ``estimator.<key>``."""
-    out = dict(defaults)
-    for key, value in (params or {}).items():
-        if key not in defaults:
-            raise AttitudeInputError(f"estimator.{key}", f"unknown parameter of {solver!r}; expected one of "
-                                                        f"{', '.join(sorted(defaults))}")
-        kind = type(defaults[key])
-        try:
-            out[key] = value if kind is str else kind(float(value)) if kind is int else kind(value)
-        except (TypeError, ValueError):
-            raise AttitudeInputError(f"estimator.{key}", f"{value!r}; expected a {kind.__name__}") from None
-        if kind is int and float(value) != out[key]:
-            raise AttitudeInputError(f"estimator.{key}", f"{value!r}; expected an integer")
-        if key in CHOICES and out[key] not in CHOICES[key]:
-            raise AttitudeInputError(f"estimator.{key}", f"{value!r}; expected one of {', '.join(CHOICES[key])}")
-        if key in LIMITS and not LIMITS[key][0](out[key]):
-            raise AttitudeInputError(f"estimator.{key}", f"{value!r}; expected {LIMITS[key][1]}")
-    return out
+    """``defaults`` overridden by ``params``, each checked against :data:`simkit.params.SCHEMA` (types, ranges,
+    choices); unknown keys and bad values raise :class:`AttitudeInputError` naming ``estimator.<key>``."""
+    return check(defaults, params, solver, AttitudeInputError)

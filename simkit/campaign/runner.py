@@ -9,17 +9,20 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import signal
+import threading
 import time
 import uuid
 from pathlib import Path
 
+from ..errors import SimkitError
 from ..version import __version__
 from .aggregate import run_table, summarise
 from .errors import CampaignInputError
 from .metrics import DEFAULT_METRICS, get
 from .plan import RunSpec, expected_text, parse_grid, plan
 from .index import write_index
-from .records import read_record, record_path, verify, write_json_atomic
+from .records import file_digest, file_identity, read_record, record_path, verify, write_json_atomic
 from .task import execute, failed_record
 
 SUMMARY_VERSION = 1
@@ -44,10 +47,26 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         with client:
             yield client
         return
-    with LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR) as cluster, \
-            Client(cluster) as client:
+    with _sigint_ignored():
+        cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
+    with cluster, Client(cluster) as client:
         yield client
+
+
+@contextlib.contextmanager
+def _sigint_ignored():
+    """SIGINT ignored while the local workers start, so that they inherit the ignored disposition: a Ctrl-C in
+    the terminal (sent to every process of the group) then stops this process alone, which closes the cluster,
+    instead of each worker dying with a page of heartbeat tracebacks. Outside the main thread: no change."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def triage(specs, run_dir: Path, metric_names) -> tuple[dict, list]:
@@ -66,6 +85,27 @@ def triage(specs, run_dir: Path, metric_names) -> tuple[dict, list]:
         else:
             todo.append((spec, None, text))
     return done, todo
+
+
+def refuse_other_settings(specs, run_dir: Path) -> None:
+    """A completed run in ``run_dir`` under a planned run's name that belongs to other settings (its record has
+    another seed or --set/--grid, or its intact file another effective scenario) is refused before anything is
+    written: a re-run would replace it. A file that differs from its own record (tampered, swapped) is not a
+    campaign's result and is run again, as before."""
+    for spec in specs:
+        rec, h5 = read_record(record_path(run_dir, spec.run_id)), run_dir / f"{spec.run_id}.h5"
+        if rec is None or rec.get("status") != "ok" or not h5.is_file():
+            continue
+        other = str(rec.get("seed")) != str(spec.seed) or list(rec.get("overrides", [])) != list(spec.overrides)
+        if not other:
+            try:
+                other = file_identity(h5)[0] != expected_text(spec) and file_digest(h5) == rec.get("sha256")
+            except SimkitError:
+                continue  # unreadable: an incomplete run, run again as before
+        if other:
+            raise CampaignInputError("-o", f"{run_dir.parent}: holds a campaign with other settings (run "
+                                     f"{spec.run_id} has another scenario, --set, --grid or seed); use another "
+                                     "folder, or remove that one")
 
 
 def _collect(client, todo, run_dir: Path, metric_names, progress: bool) -> dict:
@@ -100,12 +140,9 @@ def _bar(total: int, progress: bool):
 def check_dir(out_dir) -> Path:
     """The campaign directory ``DIR`` (not created here): a clear error when it is a file or its parent is
     missing. Absolute, since workers run in other folders (or on other machines sharing the file system)."""
-    out = Path(out_dir).absolute()
-    if out.exists() and not out.is_dir():
-        raise CampaignInputError("-o", f"{out}: is a file, expected a directory for the campaign")
-    if not out.parent.is_dir():
-        raise CampaignInputError("-o", f"{out}: the parent folder {out.parent} does not exist")
-    return out
+    from ..io.output import check_output
+
+    return check_output(Path(out_dir).absolute(), option="-o", folder=True)
 
 
 def run_campaign(scenario, out_dir, runs: int, grid=(), overrides=(), first_seed: int = 0, workers=None,
@@ -126,6 +163,7 @@ def run_campaign(scenario, out_dir, runs: int, grid=(), overrides=(), first_seed
         get(name)
     specs = plan(scenario, runs, grid, first_seed, overrides)
     out = check_dir(out_dir)
+    refuse_other_settings(specs, out / "runs")
     done, todo = triage(specs, out / "runs", metrics)
     records = dict(done)
     if todo:

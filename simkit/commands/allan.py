@@ -5,13 +5,14 @@ Every check on the arguments and the file runs before any computing; bad input i
 from __future__ import annotations
 
 import json
-import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_open
 from ..errors import DataFileError, ScenarioError
+from ..io.output import check_output
 from . import silence_stdout
 
 UNITS = {"gyro": {"Q": "rad", "N": "rad/s^0.5", "B": "rad/s", "K": "rad/s^1.5", "R": "rad/s^2", "sigma": "rad/s"},
@@ -34,20 +35,6 @@ def add_parser(sub):
     p.add_argument("--plot", metavar="OUT.png", help="save the ADEV plot (needs matplotlib: the 'plot' extra)")
     p.add_argument("--json", metavar="OUT", help="write the fitted terms as JSON")
     return p
-
-
-def _check_output(option: str, path: str | None):
-    """An output path whose directory exists and that is not itself a directory."""
-    if path is None:
-        return
-    out = Path(path)
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir():
-        raise ScenarioError(option, f"{path}: directory {str(parent)!r} does not exist")
-    if out.is_dir():
-        raise ScenarioError(option, f"{path} is a directory, expected a file name")
-    if not os.access(parent, os.W_OK):
-        raise ScenarioError(option, f"{path}: directory {str(parent)!r} is not writable")
 
 
 def _pyplot(out: str):
@@ -114,8 +101,9 @@ def _read(args):
 def run(args) -> int:
     from ..imu.allan import adev, fit
 
-    _check_output("--json", args.json)
-    _check_output("--plot", args.plot)
+    for option, out in (("--json", args.json), ("--plot", args.plot)):
+        if out is not None:
+            check_output(out, [args.file], option=option)
     _check_gauss_markov(args.gauss_markov)
     plt = _pyplot(args.plot) if args.plot else None
     dt, y, what, preset = _read(args)
@@ -132,7 +120,8 @@ def run(args) -> int:
         payload = {"file": args.file, "sensor": args.sensor, "rate_hz": 1 / dt, "units": UNITS[args.sensor],
                    "tau_s": taus.tolist(), "adev": dev.T.tolist(),
                    "fit": {axis: res.as_dict() for axis, res in results.items()}}
-        Path(args.json).write_text(json.dumps(payload, indent=2))
+        with atomic_open(args.json, "w") as f:  # never half a file
+            f.write(json.dumps(payload, indent=2))
     return 0
 
 

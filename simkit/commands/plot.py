@@ -20,7 +20,7 @@ def add_parser(sub):
 def run(args) -> int:
     from tqdm import tqdm
 
-    from ..io import open_dataset
+    from ..io import check_output, open_dataset
     from ..plots import FIGURES, file_figures, require_matplotlib, staged_directory
 
     out = Path(args.out)
@@ -28,6 +28,7 @@ def run(args) -> int:
         raise ScenarioError("--out", f"{args.out} exists and is not a directory")
     if not out.parent.is_dir():
         raise ScenarioError("--out", f"{args.out}: directory {str(out.parent)!r} does not exist")
+    check_output(out, [args.file], option="--out", folder=True)
     require_matplotlib("simkit plot")
     open_dataset(args.file).close()
     with staged_directory(out) as tmp, tqdm(total=len(FIGURES), desc="plot", unit="figure", leave=False) as bar:

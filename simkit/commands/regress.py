@@ -7,6 +7,8 @@ from pathlib import Path
 
 from ..errors import ScenarioError
 
+USER_GOLDEN = "regress_golden.json"  # where --update writes without --golden: the bundled file stays as shipped
+
 
 def add_parser(sub):
     p = sub.add_parser("regress", help="recompute scenarios and compare against golden statistics",
@@ -19,7 +21,9 @@ def add_parser(sub):
     p.add_argument("--golden", metavar="FILE.json", help="golden statistics (default: the bundled file)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario key in every recomputed run (to see what a change moves)")
-    p.add_argument("--update", action="store_true", help="rewrite the golden file from this run instead")
+    p.add_argument("--update", action="store_true",
+                   help=f"write golden statistics from this run instead of comparing: into --golden FILE, else "
+                        f"./{USER_GOLDEN} (the bundled file is never rewritten)")
     return p
 
 
@@ -52,6 +56,10 @@ def run(args) -> int:
 
     golden_path = Path(args.golden) if args.golden else regress.GOLDEN
     golden = {} if args.update and not golden_path.is_file() else regress.load_golden(golden_path)
+    if args.update:  # starts from the golden read (the bundled one by default), written to a user path
+        from ..io.output import check_output
+
+        golden_path = check_output(args.golden or USER_GOLDEN, option="--golden")
     targets = _targets(args.scenarios, golden)
     if not args.update:
         missing = [name for name, _ in targets if name not in golden]
@@ -68,8 +76,11 @@ def run(args) -> int:
               f"{'OK' if not found else f'{len(found)} drifted'}")
         drifts += found
     if args.update:
-        golden_path.write_text(json.dumps(golden, indent=1, sort_keys=True) + "\n")
-        print(f"wrote {golden_path} ({len(targets)} scenarios)")
+        from ..atomic import atomic_open
+
+        with atomic_open(golden_path, "w") as f:
+            f.write(json.dumps(golden, indent=1, sort_keys=True) + "\n")
+        print(f"wrote {golden_path} ({len(targets)} scenarios updated); compare with --golden {golden_path}")
         return 0
     for d in drifts:
         print(f"DRIFT {d}")

@@ -13,21 +13,6 @@ def add_parser(sub):
     return p
 
 
-def _out_dir(path):
-    import os
-    from pathlib import Path
-
-    from ..errors import OutputError
-
-    out = Path(path)
-    if out.exists() and not out.is_dir():
-        raise OutputError(out, "exists and is not a folder; -o takes the folder to write the RINEX files in")
-    parent = out if out.exists() else out.parent
-    if str(parent) and parent.exists() and not os.access(parent, os.W_OK):
-        raise OutputError(out, "folder is not writable")
-    return out
-
-
 def run(args) -> int:
     import tomllib
 
@@ -35,7 +20,10 @@ def run(args) -> int:
     from ..errors import DataFileError
     from ..gnss.rinex import export
 
-    out = _out_dir(args.out)
+    from ..io.output import check_name, check_output
+
+    out = check_output(args.out, [args.file], option="-o", folder=True, parents=True)
+    check_name("--name", args.name)
     with open_dataset(args.file) as ds:
         if "gnss/t" not in ds:
             raise DataFileError(args.file, "no /gnss group: the scenario has no [gnss] section")

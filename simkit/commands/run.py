@@ -13,7 +13,8 @@ def add_parser(sub):
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override any scenario key, e.g. --set scenario.duration_s=60 (repeatable)")
     p.add_argument("--force", action="store_true",
-                   help="run even when the estimated output exceeds the free disk space or the size limit")
+                   help="run even when the estimated output exceeds the free disk space or the size limit, or when -o "
+                        "names a file that is not a simkit file without /solutions (it is then replaced)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
     return p
 

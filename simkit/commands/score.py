@@ -51,6 +51,10 @@ def run(args) -> int:
     from .. import referee
 
     _check_outputs(args)
+    from ..io.output import check_outputs  # an output never replaces an input (issue 19)
+
+    check_outputs([("--json", args.json, False), ("--report", args.report, True)],
+                  [args.file, args.estimate, args.spec])
     spec = referee.load_spec(args.spec) if args.spec else None
     if args.report:
         from ..plots import require_matplotlib

@@ -55,6 +55,9 @@ def run(args) -> int:
 
     _check_numbers(args)
     plot_format = _check_plot(args.plot) if args.plot else None
+    from ..io.output import check_outputs  # an output never replaces an input (issue 19)
+
+    check_outputs([("--plot", args.plot, False)], [args.source])
     start = _start(args.start)
     const = sc.load(args.source or sc.DEFAULT_SKY, validity_days=args.validity_days)
     week, sow0 = gpstime.utc_to_gps(start)

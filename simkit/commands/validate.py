@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..atomic import atomic_open
 from ..errors import OutputError, ScenarioError
+from ..io.output import check_output
 
 
 def add_parser(sub):
@@ -59,21 +60,16 @@ def run(args) -> int:
 
 
 def _check_outputs(args):
-    """Before any work: --random >= 0, the JSON's folder exists, the report folder can be created."""
+    """Before any work: --random >= 0, --random-stride >= 1, the JSON and report paths (:func:`check_output`)."""
     if args.random < 0:
         raise ScenarioError("--random", f"found {args.random}; expected a count >= 0")
     if args.random_stride < 1:
         raise ScenarioError("--random-stride", f"found {args.random_stride}; expected an epoch step >= 1")
+    inputs = [args.input]
     if args.json:
-        folder = Path(args.json).resolve().parent
-        if not folder.is_dir():
-            raise OutputError(args.json, f"folder {str(folder)!r} does not exist")
+        check_output(args.json, inputs, option="--json")
     if args.report:
-        rep = Path(args.report)
-        if rep.exists() and not rep.is_dir():
-            raise OutputError(rep, "exists and is not a folder")
-        if not rep.resolve().parent.is_dir():
-            raise OutputError(rep, f"parent folder {str(rep.resolve().parent)!r} does not exist")
+        rep = check_output(args.report, inputs, option="--report", folder=True)
         try:
             import matplotlib  # noqa: F401
         except ImportError:

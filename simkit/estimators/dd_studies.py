@@ -84,11 +84,9 @@ def attitude_nees(scenario: str, runs: int = 10, seconds: float = 300.0, skip_s:
 
 
 def _params(pairs) -> dict:
-    out = {}
-    for item in pairs or []:
-        key, _, value = item.partition("=")
-        out[key] = json.loads(value) if value[:1] in "[{\"-0123456789tf" else value
-    return out
+    from ..params import parse_set
+
+    return parse_set(pairs or [], prefix="")  # TOML literals, as simkit solve --set
 
 
 def main(argv=None):

@@ -13,6 +13,7 @@ import numpy as np
 
 from .. import attitude as gnss_attitude
 from ..frames import ecef_to_lla, enu_to_ecef_vec, ecef_to_enu_vec, quat_from_euler
+from ..params import merge
 from ..solution import Solution
 from .align import motion_alignment, static_alignment
 from .errors import EstimatorInputError
@@ -36,57 +37,10 @@ DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
                         "dd_method": "lambda", "dd_signals": "all", "dd_mask_deg": 10.0,
                         "dd_ratio_threshold": 3.0, "dd_gate_p": 1e-6, "dd_correlation_s": 0.0,
                         "dd_correlation_window_s": 0.0}}
-CHOICES = {"gamma_rule": ("wu", "weighted"), "ionosphere": ("broadcast", "none"),
-           "dd_method": ("lambda", "clambda", "mclambda"),
-           "attitude_source": ("auto", "attitude", "none", "truth"),
-           "align": ("auto", "static", "motion", "truth", "attitude"),
-           "attitude_method": ("attitude", "attitude_c", "attitude_mc")}
-
-
-POSITIVE = {"sigma_code_m", "sigma_doppler_m_per_s", "truth_vel_sigma_m_per_s", "cov_dt_s", "p0_vel_m_per_s",
-            "pos_sigma_scale", "attitude_sigma_deg", "align_static_s", "p0_lever_m", "dd_ratio_threshold"}
-
-
-def _number(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
-
-
-def _check_value(key, default, value):
-    """The type of ``value`` matches the default's (numbers for None defaults); a few keys must be positive."""
-    if default is None and value is None:
-        return
-    if isinstance(default, bool) or isinstance(default, str):
-        ok = isinstance(value, type(default))
-        want = type(default).__name__
-    elif isinstance(default, list):
-        ok = isinstance(value, list) and len(value) == len(default) and all(map(_number, value))
-        want = f"a list of {len(default)} numbers"
-    else:
-        ok = _number(value)
-        want = "a number"
-    if not ok:
-        raise EstimatorInputError(f"estimator.{key}: expected {want}, got {value!r}")
-    if key in POSITIVE and not value > 0:
-        raise EstimatorInputError(f"estimator.{key}: expected a positive number, got {value!r}")
-    if key in CHOICES and value not in CHOICES[key]:
-        raise EstimatorInputError(f"estimator.{key}: expected one of {', '.join(CHOICES[key])}, got {value!r}")
-    if key == "dd_gate_p" and not 0 <= value < 1:
-        raise EstimatorInputError(f"estimator.dd_gate_p: expected a probability in [0, 1), got {value!r}")
-    if key in ("dd_correlation_s", "dd_correlation_window_s") and not value >= 0:
-        raise EstimatorInputError(f"estimator.{key}: expected a number >= 0 (s; 0: off), got {value!r}")
-    if key == "alpha" and not value > 1:
-        raise EstimatorInputError(f"estimator.alpha: expected > 1 (Wu 2015 uses 10), got {value!r}")
-
-
 def merged(name: str, params: dict) -> dict:
-    """Defaults of filter ``name`` overridden by ``params``; unknown keys or wrong types raise naming the key."""
-    base = DEFAULTS[name]
-    for key, value in params.items():
-        if key not in base:
-            raise EstimatorInputError(f"estimator.{key}: unknown key for --filter {name} "
-                                      f"(known: {', '.join(sorted(base))})")
-        _check_value(key, base[key], value)
-    return {**base, **params}
+    """Defaults of filter ``name`` overridden by ``params``, checked against :data:`simkit.params.SCHEMA`
+    (types, ranges, choices); an unknown key or a bad value raises naming ``estimator.<key>``."""
+    return merge(DEFAULTS[name], params, name, lambda key, message: EstimatorInputError(f"{key}: {message}"))
 
 
 def _system_of(sat_ids):
