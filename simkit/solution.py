@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import re
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -76,3 +77,11 @@ class Solution:
         for name, x in self.extras.items():
             if np.shape(x)[:1] != (k,):
                 raise ValueError(f"Solution.extras[{name!r}]: expected {k} rows, got shape {np.shape(x)}")
+
+
+def warn_truth(name: str, keys: list, meaning: dict) -> None:
+    """One stderr line naming the truth-derived inputs ``keys`` of estimator ``name`` (nothing when ``keys`` is
+    empty); ``meaning`` {key: what it reads from /truth}."""
+    if keys:
+        what = "; ".join(f"estimator.{k}=truth ({meaning[k]})" for k in keys)
+        print(f"warning: {name} reads /truth: {what}: a study input, not a receiver's", file=sys.stderr)

@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from ..frames import ecef_to_enu_matrix, ecef_to_lla
 from ..gnss.atmosphere import troposphere
-from ..solution import Solution
+from ..solution import Solution, warn_truth
 from .errors import AttitudeInputError
 from .lever import lever_velocity_differenced, lever_velocity_rate, tdcp_velocity_covariance
 from .params import TDCP_DEFAULTS, merge
@@ -134,7 +134,6 @@ def solve_tdcp(ds, params: dict | None = None, progress: bool = False) -> Soluti
              "vel_enu_imu_cov": "(m/s)^2", "clock_drift": "m/s", "n_used": "1", "n_rejected": "1",
              "residual_rms": "m"}
     truth = ["lever_attitude"] if source == "truth" else []
-    from ..estimators.registry import warn_truth  # here: the registry imports simkit.attitude
     warn_truth("tdcp", truth, {"lever_attitude": "the true attitude for the lever arm"})
     config = {"estimator": "tdcp", "signals": list(fd.signals), **p, "lever_attitude_used": source,
               "truth_inputs": truth}

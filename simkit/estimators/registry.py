@@ -14,7 +14,7 @@ import numpy as np
 from .. import attitude as gnss_attitude
 from ..frames import ecef_to_lla, enu_to_ecef_vec, ecef_to_enu_vec, quat_from_euler
 from ..params import merge
-from ..solution import Solution
+from ..solution import Solution, warn_truth
 from .align import motion_alignment, static_alignment
 from .errors import EstimatorInputError
 from .filters import FilterConfig, HInfinityFilter, KalmanFilter15, KalmanFilter15DD, KalmanFilter21
@@ -304,15 +304,6 @@ def truth_inputs(p, att_source: str | None = None) -> list:
     return [k for k in TRUTH_KEYS if used[k] == "truth"]
 
 
-def warn_truth(name: str, keys: list, meaning: dict | None = None) -> None:
-    """One stderr line naming the truth-derived inputs ``keys`` of filter ``name`` (nothing when ``keys`` is
-    empty); ``meaning`` {key: what it reads} for keys other than :data:`TRUTH_KEYS` (other estimators' keys)."""
-    meaning = {**TRUTH_KEYS, **(meaning or {})}
-    if keys:
-        what = "; ".join(f"estimator.{k}=truth ({meaning[k]})" for k in keys)
-        print(f"warning: {name} reads /truth: {what}: a study input, not a receiver's", file=sys.stderr)
-
-
 def _solved_attitude(ds, p, solver_params: dict | None = None) -> AttitudeFixes:
     """GNSS attitude from the multi-antenna carrier-phase solver ``p['attitude_method']`` of simkit.attitude
     (its defaults overridden by ``solver_params``): its Euler angles and their covariance at the epochs whose
@@ -360,7 +351,7 @@ def solve_filter(name):
         p = merged(name, params)
         src = attitude_source(ds, p) if name == "kf21" and p["use_attitude"] else None
         truth = truth_inputs(p, src)
-        warn_truth(name, truth)
+        warn_truth(name, truth, TRUTH_KEYS)
         imu, gnss = imu_data(ds), gnss_fixes(ds, p)
         align, found = resolve_align(ds, p, imu, gnss)
         init = initial_state(ds, {**p, "align": align}, imu, gnss, found)
