@@ -7,7 +7,6 @@ a filter run on simulated data is tuned to the simulated IMU unless told otherwi
 from __future__ import annotations
 
 import json
-import sys
 
 import numpy as np
 
