@@ -158,7 +158,7 @@ def solver(name: str):
         out, names = solve_arrays(fd, method, p, progress)
         single = len(names) == 2
         extras = {k: out[k] for k in _UNITS}
-        config = {"estimator": name, "ambiguity_method": method, "signals": list(fd.signals), **p}
+        config = {"estimator": name, "ambiguity_method": method, **p, "signals": list(fd.signals)}
         config["stop_s"] = None if np.isinf(p["stop_s"]) else p["stop_s"]
         return Solution(t=fd.t, quat_nb=None if single else out["quat"], euler=out["euler"], cov=out["cov"],
                         state_names=names, extras=extras, extra_units=dict(_UNITS), config=config)

@@ -133,6 +133,6 @@ def solve_tdcp(ds, params: dict | None = None, progress: bool = False) -> Soluti
     units = {"vel_enu_antenna": "m/s", "vel_enu_antenna_cov": "(m/s)^2", "vel_enu_imu": "m/s (IMU centre)",
              "vel_enu_imu_cov": "(m/s)^2", "clock_drift": "m/s", "n_used": "1", "n_rejected": "1",
              "residual_rms": "m"}
-    config = {"estimator": "tdcp", "signals": list(fd.signals), **p, "lever_attitude_used": source}
+    config = {"estimator": "tdcp", **p, "signals": list(fd.signals), "lever_attitude_used": source}
     config["stop_s"] = None if np.isinf(p["stop_s"]) else p["stop_s"]
     return Solution(t=0.5 * (fd.t[1:] + fd.t[:-1]), extras=extras, extra_units=units, config=config)
