@@ -1,5 +1,5 @@
 """Single-epoch fix and wrong-fix rates per satellite count from a simkit file, beside the bootstrapped
-success-rate prediction (issue 12's xian_static_bds table). Validation is off (ratio_threshold = 0): every epoch
+success-rate prediction (issue 12's xian_static_bds table). Validation is off (validation none): every epoch
 is fixed, so fixed-correct / wrong-fix are the empirical success / failure rates of the estimator itself.
 """
 from __future__ import annotations
@@ -26,7 +26,7 @@ def fix_table(ds, names=("attitude", "attitude_c", "attitude_mc"), counts=(4, 5,
         if name not in SOLVER_NAMES:
             raise ValueError(f"names: {name!r}; expected some of {SOLVER_NAMES}")
         for count in counts:
-            p = {"ratio_threshold": 0.0, "max_sats": count, "every": every, "continuity": 0, **params}
+            p = {"validation": "none", "ratio_threshold": 0.0, "max_sats": count, "every": every, "continuity": 0, **params}
             sol = solver(name)(ds, p, progress)
             st, use = _row_status(sol, count)
             k, n, w = int((st == 1).sum()), int(use.sum()), int((st == 3).sum())
