@@ -46,7 +46,7 @@ def _row_status(sol, count):
     return st[use], use
 
 
-def validation_table(ds, names=SOLVER_NAMES[:3], counts=(5, 6, 7, 8, 0), every=1, **params) -> list[dict]:
+def validation_table(ds, names=SOLVER_NAMES, counts=(5, 6, 7, 8, 0), every=1, **params) -> list[dict]:
     """Rows per (estimator, satellite count; 0 = all) of single-epoch resolution (continuity off) with the
     solver's validation (its default unless ``params`` say otherwise): epochs, fixed (right), wrong (accepted and
     not the file's true DD ambiguities), and the binomial bound on wrong fixes for the row's epochs at the
