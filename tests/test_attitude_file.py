@@ -95,7 +95,7 @@ def test_ffrt_holds_the_failure_rate_and_fixes_more_than_a_strict_ratio(xian):
     ds = simkit.open(xian)
     base = {"continuity": 0, "max_sats": 8, "every": 3}
     ff = SOLVERS["attitude"](ds, {**base, "validation": "ffrt", "pf": 0.01, "ffrt_samples": 2000}, False)
-    rt = SOLVERS["attitude"](ds, {**base, "ratio_threshold": 3.0}, False)
+    rt = SOLVERS["attitude"](ds, {**base, "validation": "ratio", "ratio_threshold": 3.0}, False)
     st_f, st_r = ff.extras["status"], rt.extras["status"]
     n = int((st_f >= 0).sum())
     wrong = int((st_f == 3).sum())

@@ -114,7 +114,7 @@ def test_resolve_fixes_the_true_integers(method):
     R = attitude_from_euler(0.01, -0.02, 0.7).as_matrix()
     obs, N = _obs(rng, R, m=20)
     (grp,) = float_solution(obs)
-    res = resolve(grp, method, F)
+    res = resolve(grp, method, F, validation="ratio")  # the searches; validation pf: see the test below
     ref = differencing.reference_satellites(obs.elevation, np.ones(obs.elevation.shape, bool), obs.sat_ids)
     D, ant, sat = differencing.dd_operator(ref[0], np.ones(8, bool), 3)
     truth = (N.reshape(20, -1) @ D.T)[:, np.lexsort((sat, ant))]
@@ -333,3 +333,24 @@ def test_ffrt_validation_bounds_and_options():
         resolve(grp, "clambda", F, validation="ffrt")
     with pytest.raises(AttitudeInputError, match="estimator.validation"):
         resolve(grp, "lambda", F, validation="strict")
+
+
+@pytest.mark.parametrize("method", ["lambda", "clambda", "mclambda"])
+def test_pf_validation_accepts_only_ratio_passes_whose_ils_failure_rate_is_held(method):
+    """validation=pf (the default): an epoch is accepted exactly where the method's own ratio test passes, its
+    fix is the unconstrained ILS fix (searched here independently) whose ratio passes too, and the ILS failure
+    rate is proven <= pf: the success-rate lower bound >= 1 - pf, or ILS best / 2nd <= the calibrated FFRT mu."""
+    rng = np.random.default_rng(12)
+    obs, _ = _obs(rng, attitude_from_euler(0.0, 0.0, 0.4).as_matrix(), m=30, s=7, sig_phi=0.003, sig_p=0.2)
+    (grp,) = float_solution(obs)
+    kw = dict(pf=0.01, ffrt_samples=2000)
+    res = resolve(grp, method, F, **kw)
+    own = resolve(grp, method, F, validation="ratio")
+    ils = amb.ils_batch(grp.a_hat, grp.Qa, n_cands=2)
+    best_2nd = ils.sqnorms[:, 0] / ils.sqnorms[:, 1]
+    same = np.all(ils.candidates[:, 0] == np.nan_to_num(own.z, nan=0.5), axis=1) & (best_2nd <= 1 / 3)
+    held = (1.0 - res.sr_bounds[:, 0] <= 0.01) | (best_2nd <= res.mu)
+    assert np.array_equal(res.accepted, own.accepted & same & held) and res.accepted.any()
+    assert np.array_equal(np.isfinite(res.mu), own.accepted & same)  # calibrated only where needed
+    assert method == "lambda" or (own.accepted & ~res.accepted).any()  # constrained ratio passes rejected here
+    assert np.array_equal(resolve(grp, method, F, **kw).accepted, res.accepted)  # deterministic

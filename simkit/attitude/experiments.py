@@ -1,5 +1,5 @@
 """Single-epoch fix and wrong-fix rates per satellite count from a simkit file, beside the bootstrapped
-success-rate prediction (issue 12's xian_static_bds table). Validation is off (ratio_threshold = 0): every epoch
+success-rate prediction (issue 12's xian_static_bds table). Validation is off (validation none): every epoch
 is fixed, so fixed-correct / wrong-fix are the empirical success / failure rates of the estimator itself.
 """
 from __future__ import annotations
@@ -26,11 +26,10 @@ def fix_table(ds, names=("attitude", "attitude_c", "attitude_mc"), counts=(4, 5,
         if name not in SOLVER_NAMES:
             raise ValueError(f"names: {name!r}; expected some of {SOLVER_NAMES}")
         for count in counts:
-            p = {"ratio_threshold": 0.0, "max_sats": count, "every": every, "continuity": 0, **params}
+            p = {"validation": "none", "ratio_threshold": 0.0, "max_sats": count, "every": every, "continuity": 0, **params}
             sol = solver(name)(ds, p, progress)
-            st, n_sats = sol.extras["status"], sol.extras["n_sats"]
-            use = (st >= 0) & ((n_sats == count) if count else True)
-            k, n, w = int((st[use] == 1).sum()), int(use.sum()), int((st[use] == 3).sum())
+            st, use = _row_status(sol, count)
+            k, n, w = int((st == 1).sum()), int(use.sum()), int((st == 3).sum())
             lo, hi = binomtest(k, n).proportion_ci(0.95) if n else (np.nan, np.nan)
             rows.append({"estimator": name, "sats": count or "all", "epochs": n, "fix_rate": k / n if n else np.nan,
                          "wrong_fix_rate": w / n if n else np.nan, "not_finished": n - k - w, "fix_ci95": (lo, hi),
@@ -38,6 +37,46 @@ def fix_table(ds, names=("attitude", "attitude_c", "attitude_mc"), counts=(4, 5,
                          **(ils_prediction(ds, count, every, n_samples=n_samples, **params) if name == "attitude"
                             else {"ils_sr_mc": np.nan, "ils_lower": np.nan, "ils_upper": np.nan})})
     return rows
+
+
+def _row_status(sol, count):
+    """(status of the epochs with exactly ``count`` satellites (all epochs with a solution for 0), their mask)."""
+    st, n_sats = sol.extras["status"], sol.extras["n_sats"]
+    use = (st >= 0) & ((n_sats == count) if count else True)
+    return st[use], use
+
+
+def validation_table(ds, names=SOLVER_NAMES, counts=(5, 6, 7, 8, 0), every=1, **params) -> list[dict]:
+    """Rows per (estimator, satellite count; 0 = all) of single-epoch resolution (continuity off) with the
+    solver's validation (its default unless ``params`` say otherwise): epochs, fixed (right), wrong (accepted and
+    not the file's true DD ambiguities), and the binomial bound on wrong fixes for the row's epochs at the
+    tolerated failure rate ``pf``: the 99.9 % quantile of Binomial(epochs, pf) (see :func:`wrong_fix_bound`)."""
+    rows = []
+    for name in names:
+        for count in counts:
+            sol = solver(name)(ds, {"max_sats": count, "every": every, "continuity": 0, **params}, False)
+            st, use = _row_status(sol, count)
+            n = int(use.sum())
+            rows.append({"estimator": name, "sats": count or "all", "epochs": n, "fixed": int((st == 1).sum()),
+                         "wrong": int((st == 3).sum()), "wrong_bound": wrong_fix_bound(n, sol.config["pf"])})
+    return rows
+
+
+def wrong_fix_bound(epochs: int, pf: float, level: float = 0.999) -> int:
+    """The ``level`` quantile of Binomial(``epochs``, ``pf``): a validation whose per-epoch probability of accepting
+    a wrong fix is <= pf exceeds it with probability <= 1 - level (epochs independent; correlated epochs widen the
+    real spread)."""
+    from scipy.stats import binom
+
+    return int(binom.ppf(level, epochs, pf)) if epochs else 0
+
+
+def format_validation(rows) -> str:
+    """Markdown table of :func:`validation_table` rows."""
+    out = ["| estimator | satellites | epochs | fixed | wrong | wrong-fix bound (99.9 %) |", "|---|---|---|---|---|---|"]
+    out += [f"| {r['estimator']} | {r['sats']} | {r['epochs']} | {r['fixed']} | {r['wrong']} | {r['wrong_bound']} |"
+            for r in rows]
+    return "\n".join(out)
 
 
 def ils_prediction(ds, count, every=30, n_samples=400, seed=0, **params) -> dict:

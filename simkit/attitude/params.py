@@ -11,10 +11,12 @@ AMBIGUITY_DEFAULTS = {
     "signals": "all",             # comma-separated signal names, or "all" of the file
     "mask_deg": 10.0,             # elevation mask (deg)
     "max_sats": 0,                # use at most this many (highest) satellites per epoch, references included; 0: all
-    "validation": "ratio",        # "ratio" (fixed threshold below), "ffrt" (fixed failure rate pf, LAMBDA), "none"
+    "validation": "pf",           # "pf" (ratio test, then only where the failure rate is proven <= pf: ILS success-
+                                  # rate bound, else FFRT; C-/MC-LAMBDA fixes must equal the ILS fix), "ratio"
+                                  # (fixed threshold below alone), "ffrt" (fixed failure rate pf, LAMBDA), "none"
     "ratio_threshold": 3.0,       # accept a fix when 2nd / best cost >= this (0: accept every finished search)
-    "pf": 0.001,                  # ffrt: tolerated failure rate per epoch
-    "ffrt_samples": 10_000,       # ffrt: Monte Carlo draws calibrating each epoch's threshold
+    "pf": 0.001,                  # pf, ffrt: tolerated failure rate per epoch, P(wrong fix accepted)
+    "ffrt_samples": 10_000,       # pf, ffrt: Monte Carlo draws calibrating an epoch's threshold
     "partial_p0": 0.0,            # LAMBDA: partial fixing of rejected epochs at this bootstrapped rate; 0: off
     "max_nodes": 1_000_000,       # search work cap per epoch (nodes)
     "attitude": "wls",            # "wls" (full-covariance fit; MC-LAMBDA: its own rotation), "svd" (Wahba, weight

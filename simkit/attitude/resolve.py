@@ -1,5 +1,5 @@
 """Ambiguity resolution of a group of float epochs: ILS (LAMBDA), C-LAMBDA per baseline, MC-LAMBDA, with
-validation (ratio test), partial fixing (LAMBDA) and the bootstrapped success rate per epoch.
+validation (ratio test; fixed failure rate), partial fixing (LAMBDA) and the bootstrapped success rate per epoch.
 
 Cycles for ambiguities, metres (ENU) for baselines. ``ratio`` = second-best cost / best cost (>= 1), the
 squared norm for ILS and the constrained cost for C-/MC-LAMBDA.
@@ -15,7 +15,7 @@ from .dd import FloatGroup, symmetric
 from .errors import AttitudeInputError
 
 METHODS = ("lambda", "clambda", "mclambda")
-VALIDATIONS = ("ratio", "ffrt", "none")
+VALIDATIONS = ("pf", "ratio", "ffrt", "none")
 
 
 @dataclass(frozen=True)
@@ -30,7 +30,8 @@ class Resolution:
     MC-LAMBDA (NaN otherwise); ``z_check`` (K, p) the fixed combinations and ``Z`` (K, r n, p) the integer maps
     (z_check = Z' a for the true a when right) used to label wrong fixes, p = r n for full fixes;
     ``sr_bounds`` (K, 2) lower and upper bounds of the ILS success rate (pull-in regions, bootstrapping, ADOP
-    volume); ``mu`` (K,) the fixed-failure-rate threshold on best / 2nd squared norm (NaN unless validation ffrt).
+    volume); ``mu`` (K,) the fixed-failure-rate threshold on the ILS best / 2nd squared norm (validation ffrt; pf:
+    where an epoch passed the ratio test; NaN elsewhere).
     """
 
     z: np.ndarray
@@ -86,11 +87,12 @@ def _search(grp: FloatGroup, method: str, F: np.ndarray, max_nodes: int, stop: f
 
 
 def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float = 3.0, partial_p0=None,
-            max_nodes: int = amb.DEFAULT_MAX_NODES, validation: str = "ratio", pf: float = 1e-3,
+            max_nodes: int = amb.DEFAULT_MAX_NODES, validation: str = "pf", pf: float = 1e-3,
             ffrt_samples: int = 10_000) -> Resolution:
     """Fix the ambiguities of ``grp`` with ``method`` (one of :data:`METHODS`); ``F`` (3, r) body baselines m.
 
-    ``validation`` "ratio": accept when ratio >= ``ratio_threshold`` (0 accepts every finished search); "none":
+    ``validation`` "pf": the ratio test, then only where the failure rate is proven <= ``pf`` (:func:`_hold_pf`);
+    "ratio": accept when ratio >= ``ratio_threshold`` (0 accepts every finished search); "none":
     accept every finished search; "ffrt" (LAMBDA only): fixed-failure-rate ratio test, accept when best / 2nd <=
     mu with mu calibrated per epoch on its own Qa for the failure rate ``pf`` (``ffrt_samples`` Monte Carlo
     draws; mu = 1 without draws where the lower bound of the ILS success rate is already >= 1 - pf). With
@@ -100,11 +102,11 @@ def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float 
     if method not in METHODS:
         raise AttitudeInputError("method", f"{method!r}; expected one of {', '.join(METHODS)}")
     if validation not in VALIDATIONS or (validation == "ffrt" and method != "lambda"):
-        raise AttitudeInputError("estimator.validation", f"{validation!r}; expected ratio or none, or ffrt (LAMBDA: "
-                                                         "the test is calibrated on the ILS ratio)")
+        raise AttitudeInputError("estimator.validation", f"{validation!r}; expected pf, ratio or none, or ffrt "
+                                                         "(LAMBDA: the test is calibrated on the ILS ratio)")
     if validation == "none":
         ratio_threshold = 0.0
-    stop = ratio_threshold if ratio_threshold > 0 and validation == "ratio" else 1.0  # 1: stop once best is proven
+    stop = ratio_threshold if ratio_threshold > 0 and validation in ("ratio", "pf") else 1.0  # 1: stop once best is proven
     with np.errstate(divide="ignore", invalid="ignore"):  # an unfinished search has no 2nd cost: ratio NaN / inf
         z, ratio, finished, rot, bounded = _search(grp, method, np.asarray(F, float), max_nodes, stop)
     sr, bounds = _success_rates(grp.Qa)
@@ -114,6 +116,9 @@ def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float 
         accepted = finished & (1.0 / ratio <= mu)
     else:
         accepted = finished & ((ratio >= ratio_threshold) | (ratio_threshold <= 0))
+        if validation == "pf":
+            accepted, mu = _hold_pf(grp, method, z, ratio, accepted, bounds[:, 0], pf, ffrt_samples, max_nodes,
+                                    ratio_threshold)
     b, Qb = conditioned(grp, z.astype(float))
     b = np.where(accepted[:, None], b, grp.b_hat)
     Qb = np.where(accepted[:, None, None], Qb, grp.Qb)
@@ -135,6 +140,31 @@ def _ffrt_mu(Qa, lower, pf, n_samples):
     if need.size:
         mu[need] = amb.ffrt_thresholds(Qa[need], pf, n_samples, seed=len(Qa))
     return mu
+
+
+def _hold_pf(grp, method, z, ratio, passed, lower, pf, n_samples, max_nodes, threshold):
+    """(accepted (K,), mu (K,)) of validation "pf": of the epochs that ``passed`` the method's own ratio test, keep
+    those whose ILS failure rate is proven <= ``pf``, by the lower bound ``lower`` (K,) of the ILS success rate
+    (mu = 1) or else by the fixed-failure-rate test on the ILS ratio (mu calibrated on the epoch's Qa, only for
+    these epochs: cheap where few pass). A C-/MC-LAMBDA fix is kept only where it equals the ILS fix and the ILS
+    ratio passes ``threshold`` too: then it is wrong only where ILS is, so P(wrong and accepted) <= P(ILS wrong and
+    accepted) <= pf for all three methods, and no more epochs are calibrated than for LAMBDA. The decision reads
+    the float solution only (never the truth)."""
+    mu, accepted = np.full(len(z), np.nan), np.zeros(len(z), bool)
+    idx = np.flatnonzero(passed)
+    if idx.size == 0:
+        return accepted, mu
+    if method == "lambda":
+        same, best_over_2nd = np.ones(idx.size, bool), 1.0 / ratio[idx]
+    else:
+        ils = amb.ils_batch(grp.a_hat[idx], grp.Qa[idx], n_cands=2, max_nodes=max_nodes)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            best_over_2nd = ils.sqnorms[:, 0] / ils.sqnorms[:, 1]
+        same = ils.finished & np.all(ils.candidates[:, 0] == z[idx], axis=1) & (best_over_2nd * threshold <= 1)
+    idx, best_over_2nd = idx[same], best_over_2nd[same]
+    mu[idx] = _ffrt_mu(grp.Qa[idx], lower[idx], pf, n_samples)
+    accepted[idx] = best_over_2nd <= mu[idx]
+    return accepted, mu
 
 
 def _success_rates(Qa: np.ndarray):

@@ -110,6 +110,14 @@ def _store(out: dict, grp: FloatGroup, res: Resolution, fd: FileData, R, cov):
     out["sigma_dd_carrier"][e] = np.sqrt(np.mean(np.diagonal(grp.Qphi, axis1=1, axis2=2), axis=1))
 
 
+def resolve_options(p: dict, partial: bool = True) -> dict:
+    """The keyword arguments of :func:`resolve` from the merged ambiguity parameters ``p`` (validation, its
+    threshold, pf and draws, the work cap; partial fixing unless ``partial`` is False)."""
+    return dict(ratio_threshold=p["ratio_threshold"], partial_p0=(p["partial_p0"] or None) if partial else None,
+                max_nodes=int(p["max_nodes"]), validation=p["validation"], pf=p["pf"],
+                ffrt_samples=int(p["ffrt_samples"]))
+
+
 def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> tuple[dict, tuple]:
     """Float solution, ambiguity resolution and attitude of every epoch of ``fd``: (outputs (M, ...), names)."""
     F = body_baselines(fd.lever_arm)
@@ -120,9 +128,7 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
     groups = float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None, p["float_epochs"],
                             bool(p["static"]), fd.lli)
     for grp in _progress(groups, progress, f"attitude ({method})"):
-        kw = dict(ratio_threshold=p["ratio_threshold"], partial_p0=p["partial_p0"] or None,
-                  max_nodes=int(p["max_nodes"]), validation=p["validation"], pf=p["pf"],
-                  ffrt_samples=int(p["ffrt_samples"]))
+        kw = resolve_options(p)
         if p["continuity"] and p["every"] == 1:
             res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), **kw)
         else:
@@ -158,7 +164,7 @@ def solver(name: str):
         out, names = solve_arrays(fd, method, p, progress)
         single = len(names) == 2
         extras = {k: out[k] for k in _UNITS}
-        config = {"estimator": name, "ambiguity_method": method, "signals": list(fd.signals), **p}
+        config = {"estimator": name, "ambiguity_method": method, **p, "signals": list(fd.signals)}
         config["stop_s"] = None if np.isinf(p["stop_s"]) else p["stop_s"]
         return Solution(t=fd.t, quat_nb=None if single else out["quat"], euler=out["euler"], cov=out["cov"],
                         state_names=names, extras=extras, extra_units=dict(_UNITS), config=config)

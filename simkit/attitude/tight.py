@@ -22,7 +22,7 @@ import numpy as np
 from .dd import FloatGroup, float_solution
 from .errors import AttitudeInputError
 from .resolve import METHODS, Resolution, resolve, resolve_held
-from .solvers import body_baselines, continuity_breaks, _wrong
+from .solvers import body_baselines, continuity_breaks, resolve_options, _wrong
 from .reading import FileData
 
 
@@ -106,7 +106,7 @@ def fixed_dd(fd: FileData, method: str, p: dict, correlation_s: float = 0.0, win
     if method not in METHODS:
         raise AttitudeInputError("method", f"{method!r}; expected one of {', '.join(METHODS)}")
     F = body_baselines(fd.lever_arm)
-    kw = dict(ratio_threshold=p["ratio_threshold"], partial_p0=None, max_nodes=int(p["max_nodes"]))
+    kw = resolve_options(p, partial=False)
     rows = []
     interval = float(np.median(np.diff(fd.t))) if len(fd.t) > 1 else 1.0
     inflation = correlation_inflation(correlation_s, interval, window)

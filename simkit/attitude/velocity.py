@@ -135,7 +135,7 @@ def solve_tdcp(ds, params: dict | None = None, progress: bool = False) -> Soluti
              "residual_rms": "m"}
     truth = ["lever_attitude"] if source == "truth" else []
     warn_truth("tdcp", truth, {"lever_attitude": "the true attitude for the lever arm"})
-    config = {"estimator": "tdcp", "signals": list(fd.signals), **p, "lever_attitude_used": source,
+    config = {"estimator": "tdcp", **p, "signals": list(fd.signals), "lever_attitude_used": source,
               "truth_inputs": truth}
     config["stop_s"] = None if np.isinf(p["stop_s"]) else p["stop_s"]
     return Solution(t=0.5 * (fd.t[1:] + fd.t[:-1]), extras=extras, extra_units=units, config=config,
