@@ -120,7 +120,7 @@ SCHEMA: dict[str, Param] = {
     "validation": Param(str, "fix validation: pf (ratio test and the ILS failure rate held at pf), ratio, ffrt, none",
                         choices=("pf", "ratio", "ffrt", "none")),
     "ratio_threshold": Param(float, "ratio test threshold (0: accept every search)", NONNEG),
-    "pf": Param(float, "ffrt: failure rate per epoch", within(0, 1, "a probability", True, True)),
+    "pf": Param(float, "pf and ffrt: tolerated failure rate per epoch", within(0, 1, "a probability", True, True)),
     "ffrt_samples": Param(int, "ffrt: Monte Carlo draws per epoch", at_least(1, "an integer")),
     "partial_p0": Param(float, "partial fixing success rate (0: off)", within(0, 1, "a probability", open_hi=True)),
     "max_nodes": Param(int, "search nodes per epoch at most", at_least(1, "an integer")),
