@@ -53,7 +53,7 @@ class FilterConfig:
     p0_pos: tuple = (5.0, 5.0, 10.0)
     p0_gyro_bias: float = 1e-4
     p0_accel_bias: float = 1e-2
-    p0_lever: float = 0.5
+    p0_lever: float = 0.1
     lever_rate_window_s: float = 1.0
     cov_dt: float = 0.1
     alpha: float = 10.0
