@@ -98,6 +98,7 @@ SCHEMA: dict[str, Param] = {
     "use_attitude": Param(bool, "kf21: use the GNSS attitude as a measurement"),
     "attitude_sigma_deg": Param(float, "attitude_source=truth: attitude noise (deg)", POS),
     "p0_lever_m": Param(float, "kf21: initial lever-arm sigma (m)", POS),
+    "lever_rate_window_s": Param(float, "kf21: body-rate window of the lever-arm rows (s; 0: the sample)", NONNEG),
     "lever_arm_error_m": Param(float, "kf21: error added to the file's lever arm, body x, y, z (m)", shape=3),
     "attitude_source": Param(str, "kf21: GNSS attitude from the solver, none, or the truth (a study input)",
                              choices=("auto", "attitude", "none", "truth"), needs_antennas={"attitude": 3}),

@@ -32,9 +32,15 @@ def _kalman(p, nu, h, r):
 
 
 @njit(cache=True)
-def _pv_rows(c, v, pos, lever, w_ib, z, n):
-    """Innovation (INS minus GNSS) and H of a position/velocity fix at the antenna."""
+def _pv_rows(c, v, pos, lever, w_ib, w_mean, z, n):
+    """Innovation (INS minus GNSS) and H of a position/velocity fix at the antenna: the prediction from the body
+    rate ``w_ib`` at the fix's sample, the lever-arm velocity rows (21 states) from the window mean ``w_mean``.
+    Why: the gyro noise n of w_ib is in the innovation as C (n x l); an H row C [(w + n) x] built from the same n
+    correlates with it, E[H^T nu] = E[[n x]^T [n x]] l != 0, and the estimate of l is pulled towards zero
+    (errors-in-variables regression dilution; with w ~ 0, in straight flight, all the way)."""
     pred, h = model.antenna_rows(c, v, pos, lever, w_ib, n)
+    if n >= 18:
+        h[3:6, 15:18] = c @ nav.skew(model.body_rate_nb(c, v, pos, w_mean))
     nu = pred - z
     nu[1] = model.wrap(nu[1])
     return nu, h
@@ -76,10 +82,11 @@ def allocate(m, n):
 
 
 @njit(cache=True)
-def run(phi, dvb, dt, w_ib, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_nis, dd_nis):
+def run(phi, dvb, dt, w_ib, w_mean, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_nis, dd_nis):
     """The whole recursion over the compensated increments ``phi``, ``dvb``, ``dt`` of each interval and the body
     rate ``w_ib`` (N, 3) rad/s at each sample time (:class:`.increments.Compensated`; the lever-arm velocity of a
-    fix at sample s uses w_ib[s]). ``nav0`` = (C, v, pos, bg, ba, lever); ``gnss`` = (k (M,) sample index,
+    fix at sample s uses w_ib[s]) and its mean ``w_mean`` (N, 3) rad/s over a window about each sample (the
+    lever-arm rows of H: :func:`_pv_rows`). ``nav0`` = (C, v, pos, bg, ba, lever); ``gnss`` = (k (M,) sample index,
     z (M, 6) [L, lambda, h, vE, vN, vU], R (M, 6, 6)); ``att`` = (k (K,), z (K, 3), R (K, 3, 3)); ``dd`` = (k (D,),
     row offsets (D + 1,), G (T, 3), body baselines (T, 3) m, ranges (T,) m, covariance offsets (D + 1,),
     flattened covariance blocks m^2, NIS gate (D,)). Fills ``out``, ``att_nis`` (K,) and ``dd_nis`` (D,)."""
@@ -116,7 +123,7 @@ def run(phi, dvb, dt, w_ib, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out
             elif kind == 1 and d_due:
                 nu, h, r = _dd_rows(c, dd, idd, p.shape[0])
             elif kind == 2 and g_due:
-                nu, h = _pv_rows(c, v, pos, lever, w_ib[s] - bg, gz[ig], p.shape[0])
+                nu, h = _pv_rows(c, v, pos, lever, w_ib[s] - bg, w_mean[s] - bg, gz[ig], p.shape[0])
                 r = gr[ig]
             else:
                 continue

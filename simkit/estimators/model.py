@@ -126,11 +126,17 @@ def attitude_rows(c, n):
 
 
 @njit(cache=True)
+def body_rate_nb(c, v, pos, w_ib_b):
+    """w_nb^b = w_ib^b - C^T (w_ie^n + w_en^n) (rad/s, body) at C_b^n ``c``, ENU ``v``, ``pos`` [L, lambda, h]."""
+    wie, wen = nav.rates(pos[0], pos[2], v)
+    return w_ib_b - c.T @ (wie + wen)
+
+
+@njit(cache=True)
 def antenna_rows(c, v, pos, lever, w_ib_b, n):
     """Predicted antenna [L, lambda, h, v_E, v_N, v_U] and H (6, n) for lever arm ``lever`` (body, m) and body
     rate ``w_ib_b`` (rad/s)."""
-    wie, wen = nav.rates(pos[0], pos[2], v)
-    w_nb = w_ib_b - c.T @ (wie + wen)
+    w_nb = body_rate_nb(c, v, pos, w_ib_b)
     tp = enu_to_geodetic(pos[0], pos[2])
     cl = c @ lever
     cwl = c @ nav.cross(w_nb, lever)

@@ -29,7 +29,8 @@ FILTER = {"align": "auto", "align_static_s": 10.0, "init_heading_error_deg": 0.0
           "cov_dt_s": 0.1, "pos_sigma_scale": 1.0}
 DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
             "hinf": {**COMMON, **FILTER, "alpha": 10.0, "gamma_rule": "wu"},
-            "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.5,
+            "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.1,
+                     "lever_rate_window_s": 1.0,
                      "lever_arm_error_m": [0.0, 0.0, 0.0], "attitude_source": "auto", "attitude_method": "attitude"},
             # the fixed DD carrier: ambiguity method, signals, elevation mask and ratio threshold of simkit.attitude
             "kf15_dd": {**COMMON, **FILTER,
@@ -178,7 +179,9 @@ def filter_config(ds, p, name) -> FilterConfig:
         p0_accel_bias=pick("p0_accel_bias", max(m["accel"][1] + m["accel"][3], 1e-5)),
         p0_att=tuple(np.radians(np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3))),
         p0_vel=float(p["p0_vel_m_per_s"]), p0_pos=tuple(np.broadcast_to(np.asarray(p["p0_pos_m"], float), 3)),
-        p0_lever=float(p.get("p0_lever_m", 0.5)), cov_dt=float(p["cov_dt_s"]), alpha=float(p.get("alpha", 10.0)),
+        p0_lever=float(p.get("p0_lever_m", FilterConfig.p0_lever)), cov_dt=float(p["cov_dt_s"]),
+        alpha=float(p.get("alpha", 10.0)),
+        lever_rate_window_s=float(p.get("lever_rate_window_s", FilterConfig.lever_rate_window_s)),
         gamma_rule=str(p.get("gamma_rule", "wu")), dd_gate_p=float(p.get("dd_gate_p", 0.0)),
         # "static", "motion" and "attitude" take the initial position (and attitude) from the fixes of the initial
         # epoch: only "truth" leaves them independent, to be used as measurements
