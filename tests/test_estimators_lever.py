@@ -20,27 +20,46 @@ def _jittered_times(n=400, seed=3):
     return np.concatenate([[0.0], np.cumsum(0.01 * (1.0 + 0.2 * rng.uniform(-1.0, 1.0, n - 1)))])
 
 
+def _window(n, m):
+    """The trailing window [t[j0], t[j1]] of each sample: m intervals ending 3 samples earlier."""
+    j1 = np.maximum(np.arange(n) - 3, 1)
+    return np.maximum(j1 - m, 0), j1
+
+
 def test_window_mean_of_a_linear_rate_is_the_rate_at_the_window_centre():
-    """Mean of w0 + w1 t over [t[j0], t[j1]] = the rate at (t[j0] + t[j1]) / 2 exactly, ends truncated."""
+    """Mean of w0 + w1 t over [t[j0], t[j1]] = the rate at (t[j0] + t[j1]) / 2 exactly, truncated at the start."""
     t = _jittered_times()
     w = (0.3 + 2.0 * t)[:, None] * AXIS
     comp = from_rates(t, w, np.zeros_like(w))
-    half = 7
-    s = np.arange(t.size)
-    j0, j1 = np.maximum(s - half, 0), np.minimum(s + half, t.size - 1)
+    j0, j1 = _window(t.size, 7)
     centre = 0.5 * (t[j0] + t[j1])
-    np.testing.assert_allclose(window_mean_rate(comp, half), (0.3 + 2.0 * centre)[:, None] * AXIS, atol=1e-12)
+    np.testing.assert_allclose(window_mean_rate(comp, 7), (0.3 + 2.0 * centre)[:, None] * AXIS, atol=1e-12)
     np.testing.assert_array_equal(window_mean_rate(comp, 0), comp.w_ib)
 
 
-def test_window_mean_of_a_quadratic_rate_is_off_by_its_curvature():
-    """Uniform T: the mean of c t^2 over [t - h T, t + h T] is c t^2 + c (h T)^2 / 3 (= half^2 T^2 w'' / 6)."""
+def test_window_mean_of_a_quadratic_rate_is_its_integral_over_the_window():
+    """The mean of c t^2 over [t0, t1] is c (t1^3 - t0^3) / (3 (t1 - t0)) (exact: the rate model of from_rates is
+    quadratic past its first interval)."""
     t = np.arange(300) * 0.01
-    c, half = 5.0, 10
+    c, m = 5.0, 10
     comp = from_rates(t, (c * t**2)[:, None] * AXIS, np.zeros((t.size, 3)))
-    inner = slice(half + 1, t.size - half)  # the first interval's rate model is linear (from_rates), not exact
-    expect = (c * t[inner] ** 2 + c * (half * 0.01) ** 2 / 3.0)[:, None] * AXIS
-    np.testing.assert_allclose(window_mean_rate(comp, half)[inner], expect, atol=1e-10)
+    j0, j1 = _window(t.size, m)
+    inner = j0 >= 1  # the first interval's rate model is linear (from_rates), not exact
+    expect = c * (t[j1] ** 3 - t[j0] ** 3) / (3.0 * (t[j1] - t[j0]))
+    np.testing.assert_allclose(window_mean_rate(comp, m)[inner], (expect[:, None] * AXIS)[inner], atol=1e-10)
+
+
+def test_window_mean_shares_no_noise_with_the_rate_at_the_sample():
+    """The H rows must not reuse the gyro noise of w_ib[s] (the innovation's): white noise on the samples, the
+    window mean at s is unchanged when the samples s-2 .. s (the ones w_ib[s] reads) are changed."""
+    rng = np.random.default_rng(1)
+    t = np.arange(200) * 0.01
+    gyro = rng.normal(size=(t.size, 3)) * 0.005
+    s = 120
+    moved = gyro.copy()
+    moved[s - 2:s + 1] += 1.0
+    a, b = (window_mean_rate(from_rates(t, g, np.zeros_like(g)), 10)[s] for g in (gyro, moved))
+    np.testing.assert_array_equal(a, b)
 
 
 LEVER = np.array([1.0, 2.0, 3.0])   # m, body: airborne_stim300's position antenna

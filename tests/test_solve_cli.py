@@ -60,7 +60,7 @@ def test_a_resolve_replaces_only_its_own_group(small):
     (["--filter", "kf15", "--set", "estimator.p0_pos_m=[1, 2]"], "estimator.p0_pos_m: expected a list of 3"),
     (["--filter", "kf15", "--set", "estimator.cov_dt_s=0"], "estimator.cov_dt_s: expected a number > 0, got 0"),
     (["--filter", "attitude", "--set", "estimator.validation=strict"],
-     "estimator.validation: expected one of ratio, ffrt, none, got 'strict'"),
+     "estimator.validation: expected one of pf, ratio, ffrt, none, got 'strict'"),
     (["--filter", "attitude", "--set", "estimator.pf=2"],
      "estimator.pf: expected a probability in (0, 1), got 2"),
     (["--filter", "attitude", "--set", "estimator.float_epochs=0"],

@@ -35,8 +35,8 @@ class FilterConfig:
     ``accel_vrw`` m/s^2/sqrt(Hz); bias random walks ``gyro_bias_rw`` rad/s/sqrt(s), ``accel_bias_rw``
     m/s^2/sqrt(s); initial sigmas ``p0_att`` [pitch-ish E, N, U] rad, ``p0_vel`` m/s, ``p0_pos`` [E, N, U] m,
     ``p0_gyro_bias`` rad/s, ``p0_accel_bias`` m/s^2, ``p0_lever`` m (21 states); ``lever_rate_window_s`` s: the
-    lever-arm rows of the velocity update take the body rate averaged over this window centred on the fix (0: the
-    rate at the fix's sample; see :func:`.loop._pv_rows`); ``cov_dt`` s covariance step;
+    lever-arm rows of the velocity update take the body rate averaged over this trailing window, ending three
+    samples before the fix (0: the rate at the fix's sample; see :func:`.loop._pv_rows`); ``cov_dt`` s covariance step;
     ``alpha`` H-infinity tuning (Wu 2015: 10); ``gamma_rule``
     "wu" (Wu's H^T H, with the weighted rule as fallback) or "weighted" (H^T R^-1 H);
     ``gyro_bias0``/``accel_bias0`` initial bias estimates (body); ``dd_gate_p`` (kf15_dd) rejects a DD carrier
@@ -54,7 +54,7 @@ class FilterConfig:
     p0_gyro_bias: float = 1e-4
     p0_accel_bias: float = 1e-2
     p0_lever: float = 0.1
-    lever_rate_window_s: float = 1.0
+    lever_rate_window_s: float = 0.1
     cov_dt: float = 0.1
     alpha: float = 10.0
     gyro_bias0: tuple = (0.0, 0.0, 0.0)
@@ -179,7 +179,7 @@ class _LooselyCoupled:
         darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p), first)
         out = loop.allocate(idx.size, n)
         att_nis, dd_nis = np.full(aarr[0].size, np.nan), np.full(darr[0].size, np.nan)
-        w_mean = window_mean_rate(comp, int(round(0.5 * cfg.lever_rate_window_s / float(np.median(comp.dt)))))
+        w_mean = window_mean_rate(comp, int(round(cfg.lever_rate_window_s / float(np.median(comp.dt)))))
         loop.run(comp.phi, comp.dvb, comp.dt, comp.w_ib, w_mean, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n),
                  float(cfg.cov_dt), garr, aarr, darr, self._mode(), float(cfg.alpha), out, att_nis, dd_nis)
         sol = self._solution(imu.t[garr[0]], out, att_nis)

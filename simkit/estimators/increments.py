@@ -138,16 +138,17 @@ def from_increments(t, dtheta, dvel) -> Compensated:
     return _compensate(gyro_poly, _fit_quadratics(dt, dv), dt, gyro_poly[0, 0] / dt[0])
 
 
-def window_mean_rate(comp: Compensated, half: int) -> np.ndarray:
-    """Body rate (N, 3) rad/s at each sample time averaged over the samples ``half`` either side (truncated at
-    the ends): the rotation vectors ``comp.phi`` summed over the window over its length (the coning part of phi
-    is second order). Its white noise is (2 half + 1) times smaller in variance than that of ``comp.w_ib``; the
-    mean of a rate that is quadratic over the window is off by half^2 T^2 w''/6. ``half`` = 0 gives ``w_ib``."""
-    if half <= 0:
+def window_mean_rate(comp: Compensated, m: int) -> np.ndarray:
+    """Body rate (N, 3) rad/s at each sample s averaged over the ``m`` intervals that end at sample s - 3 (a
+    trailing window, truncated at the start): the rotation vectors ``comp.phi`` summed over the window over its
+    length (the coning part of phi is second order). It shares no sample with ``comp.w_ib[s]`` (whose quadratic
+    model reads samples s-2 .. s, or the increments ending there), so its white noise is independent of that of
+    w_ib[s] and m times smaller in variance; it lags the sample by 3 T + m T / 2. ``m`` = 0 gives ``w_ib``."""
+    if m <= 0:
         return comp.w_ib.copy()
     n = comp.w_ib.shape[0]
     theta = np.vstack([np.zeros((1, 3)), np.cumsum(comp.phi, axis=0)])   # (N, 3) rad: integral to each sample
     t = np.concatenate([[0.0], np.cumsum(comp.dt)])
-    s = np.arange(n)
-    j0, j1 = np.maximum(s - half, 0), np.minimum(s + half, n - 1)
+    j1 = np.maximum(np.arange(n) - 3, 1)
+    j0 = np.maximum(j1 - m, 0)
     return (theta[j1] - theta[j0]) / (t[j1] - t[j0])[:, None]

@@ -30,7 +30,7 @@ FILTER = {"align": "auto", "align_static_s": 10.0, "init_heading_error_deg": 0.0
 DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
             "hinf": {**COMMON, **FILTER, "alpha": 10.0, "gamma_rule": "wu"},
             "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.1,
-                     "lever_rate_window_s": 1.0,
+                     "lever_rate_window_s": 0.1,
                      "lever_arm_error_m": [0.0, 0.0, 0.0], "attitude_source": "auto", "attitude_method": "attitude"},
             # the fixed DD carrier: ambiguity method, signals, elevation mask and ratio threshold of simkit.attitude
             "kf15_dd": {**COMMON, **FILTER,
