@@ -84,12 +84,11 @@ def allocate(m, n):
 @njit(cache=True)
 def run(phi, dvb, dt, w_ib, w_mean, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_nis, dd_nis):
     """The recursion over the compensated increments ``phi``, ``dvb``, ``dt`` and the body rate ``w_ib`` (N, 3)
-    rad/s at each sample (:class:`.increments.Compensated`; a fix at sample s predicts its lever-arm velocity with
-    w_ib[s], H's lever rows use ``w_mean`` (N, 3), a trailing window mean: :func:`_pv_rows`). ``nav0`` = (C, v,
-    pos, bg, ba, lever); ``gnss`` = (k (M,) sample index, z (M, 6) [L, lambda, h, vE, vN, vU], R (M, 6, 6));
-    ``att`` = (k (K,), z (K, 3), R (K, 3, 3)); ``dd`` = (k (D,), row offsets (D + 1,), G (T, 3), body baselines
-    (T, 3) m, ranges (T,) m, covariance offsets (D + 1,), flattened covariance blocks m^2, NIS gate (D,)). Fills
-    ``out``, ``att_nis`` (K,) and ``dd_nis`` (D,)."""
+    rad/s at each sample (:class:`.increments.Compensated`; a fix at sample s predicts its lever velocity with
+    w_ib[s], H's lever rows use the trailing mean ``w_mean`` (N, 3): :func:`_pv_rows`). ``nav0`` = (C, v, pos,
+    bg, ba, lever); ``gnss`` = (k (M,) sample index, z (M, 6) [L, lambda, h, vE, vN, vU], R (M, 6, 6)); ``att`` =
+    (k (K,), z (K, 3), R (K, 3, 3)); ``dd`` = (k (D,), row offsets (D + 1,), G (T, 3), body baselines (T, 3) m,
+    ranges (T,) m, covariance offsets, covariance blocks m^2, NIS gate (D,)). Fills out, att_nis (K,), dd_nis (D,)."""
     c, v, pos, bg, ba, lever = nav0
     gk, gz, gr = gnss
     ak, az, ar = att
