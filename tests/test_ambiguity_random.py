@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from simkit import ambiguity as amb
-from simkit.ambiguity.problems import random_problem
+from studies.ambiguity_problems import random_problem
 
 N_PROBLEMS = 10_000
 

@@ -6,7 +6,7 @@ import pytest
 
 import simkit
 from simkit.attitude import SOLVERS
-from simkit.attitude.experiments import validation_table, wrong_fix_bound
+from studies.attitude import validation_table, wrong_fix_bound
 
 pytestmark = pytest.mark.slow  # simulates a 1000 s file (~5 s) and solves it 23 times (minutes under load)
 

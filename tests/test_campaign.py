@@ -9,7 +9,7 @@ from scipy import stats as sps
 import simkit
 from cli_errors import assert_clean_error
 from simkit.ambiguity import adop_upper_bound
-from simkit.ambiguity.experiments import float_solution
+from simkit.gnss.differencing import float_solution
 from simkit.campaign import CampaignInputError, mean_interval, parse_grid, plan, wilson_interval
 from simkit.campaign.ambiguity_metric import ambiguity, dd_observations
 from simkit.campaign.plan import grid_points, split_values
