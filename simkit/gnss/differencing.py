@@ -13,13 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SimkitError
+from ..errors import InputError
 
 
-class DifferencingInputError(SimkitError, ValueError):
+class DifferencingInputError(InputError):
     """An array given to the differencing functions has the wrong shape (names the argument)."""
-
-    exit_code = 2
 
 
 def _obs(x, what: str = "x") -> np.ndarray:

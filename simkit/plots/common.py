@@ -9,13 +9,11 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..errors import SimkitError
+from ..errors import InputError
 
 
-class PlotDependencyError(SimkitError):
+class PlotDependencyError(InputError):
     """matplotlib is missing: the ``plot`` extra is not installed."""
-
-    exit_code = 2
 
 
 def require_matplotlib(option: str = "plot"):
