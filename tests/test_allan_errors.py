@@ -64,7 +64,7 @@ CASES = [
     (lambda f: [str(f["good"]), "--json", str(f["good"])], "is an input of this command"),
     (lambda f: [str(f["good"]), "--plot", str(f["good"])], "is an input of this command"),
     (lambda f: [str(f["good"]), "--json", "."], "is a directory"),
-    (lambda f: [str(f["good"]), "--plot", "adev.notaformat"], "unknown image format 'notaformat'"),
+    (lambda f: [str(f["good"]), "--plot", "adev.notaformat"], "--plot: adev.notaformat: unknown image format 'notaformat'"),
 ]
 
 
