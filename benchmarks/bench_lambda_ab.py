@@ -4,7 +4,7 @@ a few per cent: each tree runs in its own interpreter, alternating, ``--rounds``
 
     git worktree add /tmp/before <rev>; python benchmarks/bench_lambda_ab.py /tmp/before .
 
-(bench_lambda.py gives the ratio to RTKLIB's C in the same run; its per-run noise is about +-20 %.)
+(bench_lambda.py gives the ratio to RTKLIB's C in the same run, with more per-run noise: docs/benchmarks.md.)
 """
 from __future__ import annotations
 

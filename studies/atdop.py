@@ -1,4 +1,5 @@
-"""Attitude error with fixed ambiguities against its predictions (issue 12, "ATDOP times the carrier noise").
+"""Attitude error with fixed ambiguities against its predictions ("ATDOP times the carrier noise",
+docs/attitude.md).
 
 ``python -m studies.atdop FILE [--set key=value ...]`` prints JSON: per axis [pitch, roll,
 heading] the RMS error of the ``attitude`` solver's fixed epochs (status 1, single epoch) against /truth/euler,

@@ -1,5 +1,5 @@
 """Single-epoch fix and wrong-fix rates per satellite count from a simkit file, beside the bootstrapped
-success-rate prediction (issue 12's xian_static_bds table). Validation is off (validation none): every epoch
+success-rate prediction (the xian_static_bds table of docs/attitude.md). Validation is off (validation none): every epoch
 is fixed, so fixed-correct / wrong-fix are the empirical success / failure rates of the estimator itself.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Fix rate of LAMBDA against the number of epochs in the float solution (issue 12 item 1, several epochs).
+"""Fix rate of LAMBDA against the number of epochs in the float solution (several epochs, docs/attitude.md).
 
 ``python -m studies.attitude_float FILE [--counts 5,6] [--windows 1,2,5,10] [--every 30] [--static]``
 prints a markdown table: per satellite count and window length N, the single-shot LAMBDA (ILS, no validation)

@@ -16,7 +16,7 @@ def _sizes(rng):
 
 
 class _Rtklib:
-    """RTKLIB's lambda with buffers allocated once per size (see shared/notes/pyrtklib.md)."""
+    """RTKLIB's lambda with buffers allocated once per size."""
 
     def __init__(self):
         import pyrtklib

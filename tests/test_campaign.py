@@ -138,7 +138,7 @@ def test_task_adds_missing_metrics_without_rerunning_and_keeps_a_completed_run(t
 
 
 def test_a_folder_of_other_settings_is_refused_and_left_as_it_was(tmp_path):
-    """issue 19 (9): reusing a campaign folder with other settings overwrote its runs silently."""
+    """Regression: reusing a campaign folder with other settings overwrote its runs silently."""
     from cli_errors import digest
     from simkit.campaign.task import execute
 

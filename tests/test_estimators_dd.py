@@ -193,7 +193,7 @@ def test_kf15_dd_attitude_nees_is_within_the_chi2_bounds_over_a_monte_carlo(tmp_
 
 
 def test_kf15_dd_on_a_static_site_aligns_automatically_from_the_fixed_attitude(xian):
-    """Issue 12: ``simkit solve xian.h5 --filter kf15_dd`` with no align key: "auto" takes the carrier-phase
+    """``simkit solve xian.h5 --filter kf15_dd`` with no align key: "auto" takes the carrier-phase
     attitude (3 antennas fix), reports it, and the heading is held to the DD level (a MEMS gyro cannot
     gyrocompass: "static" would start degrees off and the gate would reject the DD rows)."""
     proc = run_cli(["solve", str(xian), "--filter", "kf15_dd", "-q"], xian.parent)

@@ -11,7 +11,8 @@ from simkit.ambiguity import AmbiguityInputError, ils
 from simkit.errors import InputError, SimkitError
 from tests.cli_errors import run_cli
 
-STAGE_ERRORS = [("simkit.errors", "ScenarioError"), ("simkit.errors", "DataFileError"), ("simkit.errors", "OutputError"),
+STAGE_ERRORS = [("simkit.errors", "ScenarioError"), ("simkit.errors", "DataFileError"),
+                ("simkit.errors", "OutputError"),
                 ("simkit.ambiguity", "AmbiguityInputError"), ("simkit.attitude", "AttitudeInputError"),
                 ("simkit.estimators", "EstimatorInputError"), ("simkit.campaign", "CampaignInputError"),
                 ("simkit.constellation.errors", "ConstellationInputError"), ("simkit.referee", "RefereeInputError"),

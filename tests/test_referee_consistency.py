@@ -1,4 +1,4 @@
-"""Solutions that do not estimate everything (issue 19, defect 5): NaN blocks of a covariance reduce the NEES
+"""Solutions that do not estimate everything: NaN blocks of a covariance reduce the NEES
 dimension (checked against scipy.stats.chi2 and the closed-form quadratic forms of each block); an Euler-only
 attitude with a NaN roll (two antennas) is scored on pitch and heading and says what it leaves out; the
 covariance of a filter's own error states (d_lat, d_lon, d_h, dv_*, phi_*) gives the +-3 sigma bands."""

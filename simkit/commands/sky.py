@@ -17,8 +17,8 @@ from ..errors import ScenarioError
 from . import silence_stdout
 
 MEMORY_LIMIT_BYTES = 2 * 1024**3
-# working memory of the geometry and DOPs: tracemalloc peak 206 B per satellite-epoch (67 and 24 satellites x
-# 4000 epochs), rounded up; the per-epoch part covers the time arrays. `python benchmarks/bench_constellation.py`
+# working memory of the geometry and DOPs per satellite-epoch: the measured peak rounded up (docs/benchmarks.md);
+# the per-epoch part covers the time arrays
 BYTES_PER_SAT_EPOCH = 256
 BYTES_PER_EPOCH = 64
 HEIGHT_RANGE_M = (-11000.0, 20.0e6)  # deepest ocean floor .. below the GNSS orbits
@@ -53,7 +53,7 @@ def run(args) -> int:
 
     _check_numbers(args)
     plot_format = _check_plot(args.plot) if args.plot else None
-    from ..io.output import check_outputs  # an output never replaces an input (issue 19)
+    from ..io.output import check_outputs  # an output never replaces an input
 
     check_outputs([("--plot", args.plot, False)], [args.source])
     start = _start(args.start)
