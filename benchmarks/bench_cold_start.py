@@ -26,7 +26,7 @@ import json, time
 t0 = time.perf_counter()
 import numpy as np
 from simkit.ambiguity import ils
-from simkit.ambiguity.problems import random_problem
+from studies.ambiguity_problems import random_problem
 from simkit.ambiguity.warmup import wait_for_jit
 t1 = time.perf_counter()
 a, Q, _ = random_problem(np.random.default_rng(1), 10, "well")

@@ -20,7 +20,6 @@ from simkit.constellation.sources import DEFAULT_SKY, resolve
 from simkit.gnss import GnssSimulator, parse_config
 from simkit.section import Section
 
-SHARED_NAV = Path(__file__).resolve().parents[2] / "shared" / "data" / "rinex_nav" / DEFAULT_SKY
 START = (2416, 86400.0)  # 2026-04-27 00:00 GPST, the day of the BRDM file
 ORIGIN = np.radians([34.2, 108.9])
 
@@ -29,7 +28,7 @@ def sky_source() -> str:
     try:
         return str(resolve(DEFAULT_SKY))
     except Exception:
-        return str(SHARED_NAV) if SHARED_NAV.is_file() else "nominal:gps+bds"
+        return "nominal:gps+bds"
 
 
 def ours(hours: float, block: int = 600):

@@ -2,7 +2,7 @@
 
 Prints our throughput, peak RSS, and the ratio against
   (a) gnss-ins-sim's IMU error generation (``pathgen.gyro_gen`` / ``acc_gen``: constant bias, first-order
-      Gauss-Markov bias drift, white noise; fewer terms than ours), from the shared peers folder (not on PyPI);
+      Gauss-Markov bias drift, white noise; fewer terms than ours), from a checkout named by GNSS_INS_SIM (not on PyPI);
   (b) allantools' flicker-noise generator (Kasdin fractional-difference, allantools.noise.pink);
   (c) allantools.oadev against simkit.imu.allan.adev on the same record.
 Run: python benchmarks/bench_imu.py [--hours H] [--compression none|lzf|gzip]

@@ -1,18 +1,21 @@
 """Per-solve time of simkit.ambiguity.ils vs RTKLIB's C lambda (pyrtklib) and cssrlib's Python mlambda.
 
-Run: python benchmarks/bench_lambda.py. Same random problems (simkit.ambiguity.problems.random_problem, "well"
+Run: python benchmarks/bench_lambda.py. Same random problems (studies.ambiguity_problems.random_problem, "well"
 conditioned, i.e. GNSS-like after a few epochs) for every solver; RTKLIB is timed on pre-filled buffers; medians
 over problems of the per-problem mean time. The compiled kernel is timed (see simkit/ambiguity/warmup.py; the
 cold start is benchmarks/bench_cold_start.py).
 """
 import os
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from simkit.ambiguity import ils
-from simkit.ambiguity.problems import random_problem
-from simkit.ambiguity.warmup import wait_for_jit
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # this checkout, and its studies/
+from simkit.ambiguity import ils  # noqa: E402
+from simkit.ambiguity.warmup import wait_for_jit  # noqa: E402
+from studies.ambiguity_problems import random_problem  # noqa: E402
 
 
 def _time(fn, reps):

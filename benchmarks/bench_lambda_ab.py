@@ -4,18 +4,22 @@ a few per cent: each tree runs in its own interpreter, alternating, ``--rounds``
 
     git worktree add /tmp/before <rev>; python benchmarks/bench_lambda_ab.py /tmp/before .
 
-(bench_lambda.py gives the ratio to RTKLIB's C in the same run; its per-run noise is about +-20 %.)
+(bench_lambda.py gives the ratio to RTKLIB's C in the same run, with more per-run noise: docs/benchmarks.md.)
 """
 from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
 
 PROBE = r"""
 import sys, time, numpy as np
 sys.path.insert(0, sys.argv[1])
+sys.path.append(sys.argv[2])  # the problems of this checkout's studies/, the same for both trees
 from simkit.ambiguity import ils
-from simkit.ambiguity.problems import random_problem
+from studies.ambiguity_problems import random_problem
 try:
     from simkit.ambiguity.warmup import wait_for_jit
 except ImportError:
@@ -52,7 +56,7 @@ def main(argv=None) -> int:
     print(f"{'tree':<30} {'n=10 us':>8} {'n=20 us':>8} {'n=40 us':>8}")
     for _ in range(args.rounds):
         for root in (args.a, args.b):
-            out = subprocess.run([sys.executable, "-c", PROBE, root], capture_output=True, text=True, check=True)
+            out = subprocess.run([sys.executable, "-c", PROBE, root, str(ROOT)], capture_output=True, text=True, check=True)
             print(f"{root:<30} " + " ".join(f"{v:>8}" for v in out.stdout.split()))
     return 0
 

@@ -1,8 +1,8 @@
 """Benchmark: truth generation for 1 h at 1 kHz, with and without the compressed HDF5 write (targets >= 1,000,000
 samples/s with the write, peak RSS < 1 GiB), against gnss-ins-sim's trajectory generator in the same run.
 
-The peer is gnss-ins-sim (github.com/Aceinna/gnss-ins-sim, not on PyPI), imported from the shared peers folder
-(``--peer``; default ``../shared/peers/gnss-ins-sim`` next to the checkout). Its ``pathgen.path_gen`` makes the
+The peer is gnss-ins-sim (github.com/Aceinna/gnss-ins-sim, not on PyPI), imported from a checkout
+(``--peer``, or the ``GNSS_INS_SIM`` environment variable). Its ``pathgen.path_gen`` makes the
 true position, velocity, attitude, body rate and specific force from motion commands, one Python step per sample,
 so it runs on a shorter record of turns, 200 deg/s rolls and a climbing acceleration at the same rate
 (``--peer-seconds``); samples per second is the figure compared. Without the peer only our figures are printed.
@@ -89,7 +89,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seconds", type=float, default=3600.0)
     ap.add_argument("--rate", type=float, default=1000.0)
     ap.add_argument("--peer-seconds", type=float, default=40.0)
-    ap.add_argument("--peer", help="gnss-ins-sim checkout (default: ../shared/peers/gnss-ins-sim)")
+    ap.add_argument("--peer", help="gnss-ins-sim checkout (default: $GNSS_INS_SIM)")
     args = ap.parse_args(argv)
     with_write, alone, size = ours(args.seconds, args.rate)
     peak = peak_rss()

@@ -1,12 +1,12 @@
-"""Where the benchmarks find gnss-ins-sim (github.com/Aceinna/gnss-ins-sim, not on PyPI): the project's shared
-peers folder next to the checkout, or a path given on the command line."""
+"""Where the benchmarks find gnss-ins-sim (github.com/Aceinna/gnss-ins-sim, not on PyPI): a checkout given on the
+command line, or named by the ``GNSS_INS_SIM`` environment variable."""
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-CANDIDATES = [p / "shared" / "peers" / "gnss-ins-sim" for p in (ROOT.parent, ROOT.parent.parent)]
+CANDIDATES = [Path(os.environ["GNSS_INS_SIM"])] if os.environ.get("GNSS_INS_SIM") else []
 
 
 def gnss_ins_sim(path: str | None = None):

@@ -12,7 +12,7 @@ import signal
 import sys
 
 from .commands import silence_stdout
-from .errors import SimkitError
+from .errors import InputError, SimkitError
 from .version import __version__
 
 COMMANDS = ("run", "inspect", "solve", "validate", "score", "plot", "regress", "campaign", "allan", "sky", "rinex")
@@ -55,7 +55,7 @@ def main(argv=None) -> int:
     except SimkitError as exc:
         _close_bars()
         print(f"simkit {args.command}: error: {exc}", file=sys.stderr)
-        return exc.exit_code
+        return 2 if isinstance(exc, InputError) else exc.exit_code
     except KeyboardInterrupt as exc:
         _close_bars()
         print(f"simkit {args.command}: interrupted{f' ({exc})' if str(exc) else ''}", file=sys.stderr)

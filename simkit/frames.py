@@ -1,6 +1,6 @@
 """Frames and attitude: ECEF <-> geodetic (pymap3d, WGS-84), ECEF <-> ENU rotations, Euler <-> rotation.
 
-Conventions (DESIGN.md): navigation frame n = local-level ENU; body frame b = x right, y forward, z up.
+Conventions (README, "Conventions"): navigation frame n = local-level ENU; body frame b = x right, y forward, z up.
 Attitude is the rotation body -> ENU (``scipy.spatial.transform.Rotation``, quaternions scalar-last) built as
 C_b^n = R_z(yaw) R_x(pitch) R_y(roll) with yaw = -heading (heading clockwise from north). Euler triples are
 ordered [pitch, roll, heading]. Positive pitch is nose up, positive roll is right wing down.

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import tomllib
 from dataclasses import dataclass
 from typing import Callable
 
@@ -229,11 +230,17 @@ def check_against_file(params: dict, defaults: dict, n_antennas: int, path, erro
             raise error(f"estimator.{key}", f"{value!r} needs {need} or more antennas, {path} has {n_antennas}")
 
 
-def parse_set(items, prefix: str = "estimator.") -> dict:
-    """``--set <prefix>key=value`` items -> {key: value}; values are TOML literals (the scenario ``--set``
-    parser, :func:`simkit.scenario.loader.parse_value`)."""
-    from .scenario.loader import parse_value
+def parse_value(text: str):
+    """A ``--set`` value: a TOML literal (number, bool, string, array, inline table) or else a bare string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
 
+
+def parse_set(items, prefix: str = "estimator.") -> dict:
+    """``--set <prefix>key=value`` items -> {key: value}; values are TOML literals (:func:`parse_value`, as the
+    scenario's ``--set``)."""
     out = {}
     for item in items:
         key, sep, text = item.partition("=")

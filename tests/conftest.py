@@ -6,6 +6,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parent / "data"  # real data files with provenance (data/SOURCES.md)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(1, str(ROOT))  # the lab scripts in studies/ (not shipped in the wheel) that some tests reuse
 
 
 @pytest.fixture(scope="session")

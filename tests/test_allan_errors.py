@@ -60,11 +60,11 @@ CASES = [
     (lambda f: [str(f["stuck"])], "/imu/t does not increase"),
     (lambda f: [str(f["good"]), "--json", "nodir/out.json"], "--json: nodir/out.json: folder nodir does not exist"),
     (lambda f: [str(f["good"]), "--plot", "nodir/adev.png"], "--plot: nodir/adev.png: folder nodir does not"),
-    # issue 19 (6): the output is never the file being read
+    # the output is never the file being read
     (lambda f: [str(f["good"]), "--json", str(f["good"])], "is an input of this command"),
     (lambda f: [str(f["good"]), "--plot", str(f["good"])], "is an input of this command"),
     (lambda f: [str(f["good"]), "--json", "."], "is a directory"),
-    (lambda f: [str(f["good"]), "--plot", "adev.notaformat"], "unknown image format 'notaformat'"),
+    (lambda f: [str(f["good"]), "--plot", "adev.notaformat"], "adev.notaformat: unknown image format"),
 ]
 
 

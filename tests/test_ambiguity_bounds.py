@@ -7,7 +7,7 @@ import pytest
 from scipy.special import erf
 
 from simkit import ambiguity as amb
-from simkit.ambiguity.problems import random_problem
+from studies.ambiguity_problems import random_problem
 from simkit.ambiguity.success import ils_success_bounds, pullin_lower_bound, pullin_upper_bound
 
 from conftest import DATA as _DATA_DIR

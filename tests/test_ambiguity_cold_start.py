@@ -14,7 +14,7 @@ import pytest
 
 from simkit import ambiguity as amb
 from simkit.ambiguity import search
-from simkit.ambiguity.problems import random_problem
+from studies.ambiguity_problems import random_problem
 from simkit.ambiguity.warmup import interpreted
 
 from conftest import DATA, ROOT

@@ -5,9 +5,9 @@ from scipy.optimize import minimize
 from scipy.spatial.transform import Rotation
 
 from simkit import ambiguity as amb
-from simkit.ambiguity.experiments import (GPS_L1_WAVELENGTH_M, float_solution, format_table, simulate_epochs,
-                                          sky_uniform_los, success_table)
 from simkit.ambiguity.inner import rotation_fit, sphere_fit
+from simkit.gnss.differencing import float_solution
+from studies.ambiguity import GPS_L1_WAVELENGTH_M, format_table, simulate_epochs, sky_uniform_los, success_table
 
 
 def _sphere_reference(c, W, length):

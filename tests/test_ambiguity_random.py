@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from simkit import ambiguity as amb
-from simkit.ambiguity.problems import random_problem
+from studies.ambiguity_problems import random_problem
 
 N_PROBLEMS = 10_000
 
@@ -16,7 +16,7 @@ def _sizes(rng):
 
 
 class _Rtklib:
-    """RTKLIB's lambda with buffers allocated once per size (see shared/notes/pyrtklib.md)."""
+    """RTKLIB's lambda with buffers allocated once per size."""
 
     def __init__(self):
         import pyrtklib

@@ -1,4 +1,5 @@
-"""The published LAMBDA test vectors (tests/data/lambda_testvectors.json, a copy of shared/lambda_testvectors.json) reproduced by simkit.ambiguity."""
+"""The published LAMBDA test vectors (tests/data/lambda_testvectors.json, provenance in tests/data/SOURCES.md)
+reproduced by simkit.ambiguity."""
 import json
 
 import numpy as np

@@ -72,7 +72,7 @@ def test_single_epoch_lambda_rates_agree_with_the_predicted_success_rate(tmp_pat
     """Wang's site, 6 and 7 satellites (the counts where the rate is neither 0 nor 1): the measured LAMBDA fix
     rate against the Monte Carlo ILS success rate of the same epochs' float covariances, and above the
     bootstrapped lower bound, within the binomial 99 % interval."""
-    from simkit.attitude.experiments import fix_table
+    from studies.attitude import fix_table
 
     path = simkit.run("xian_static_bds", out=tmp_path / "x.h5", overrides=["scenario.duration_s=10800",
                                                                            "imu.preset=ideal"])

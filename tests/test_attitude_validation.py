@@ -1,12 +1,12 @@
 """Default ambiguity validation of the attitude solvers on a simulated airborne file: single-epoch resolution at
-forced satellite counts must not accept more wrong fixes than the tolerated failure rate pf allows (issue 19,
-defect 12), and the solutions record the signals they used."""
+forced satellite counts must not accept more wrong fixes than the tolerated failure rate pf allows
+(docs/attitude.md, "Validation at low satellite counts"), and the solutions record the signals they used."""
 import numpy as np
 import pytest
 
 import simkit
 from simkit.attitude import SOLVERS
-from simkit.attitude.experiments import validation_table, wrong_fix_bound
+from studies.attitude import validation_table, wrong_fix_bound
 
 pytestmark = pytest.mark.slow  # simulates a 1000 s file (~5 s) and solves it 23 times (minutes under load)
 

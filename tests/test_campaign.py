@@ -9,7 +9,7 @@ from scipy import stats as sps
 import simkit
 from cli_errors import assert_clean_error
 from simkit.ambiguity import adop_upper_bound
-from simkit.ambiguity.experiments import float_solution
+from simkit.gnss.differencing import float_solution
 from simkit.campaign import CampaignInputError, mean_interval, parse_grid, plan, wilson_interval
 from simkit.campaign.ambiguity_metric import ambiguity, dd_observations
 from simkit.campaign.plan import grid_points, split_values
@@ -138,7 +138,7 @@ def test_task_adds_missing_metrics_without_rerunning_and_keeps_a_completed_run(t
 
 
 def test_a_folder_of_other_settings_is_refused_and_left_as_it_was(tmp_path):
-    """issue 19 (9): reusing a campaign folder with other settings overwrote its runs silently."""
+    """Regression: reusing a campaign folder with other settings overwrote its runs silently."""
     from cli_errors import digest
     from simkit.campaign.task import execute
 

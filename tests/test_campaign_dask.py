@@ -150,7 +150,7 @@ def _read_pty(fd: int, until: float) -> str:
 
 
 def test_ctrl_c_on_a_campaign_is_one_line(tmp_path):
-    """issue 19 (9): Ctrl-C in a terminal (SIGINT to the whole foreground group, workers included) printed about
+    """Regression: Ctrl-C in a terminal (SIGINT to the whole foreground group, workers included) printed about
     60 lines of Dask heartbeat tracebacks from the workers; now the command alone stops, in one line, exit 130."""
     import pty
 

@@ -1,8 +1,9 @@
 """Every ``nominal:`` source against first principles and the published constellation definitions.
 
 Authorities: vis-viva v^2 = mu (2/r - 1/a) and Kepler's third law T = 2 pi sqrt(a^3/mu), with each system's mu
-(DESIGN.md); the GPS SPS Performance Standard (2 revolutions per sidereal day: period 11 h 58 min); the measured
-GPS orbit repeat time, about 245 s short of a solar day, i.e. ~86,155 s, a few seconds spread per satellite
+(IS-GPS-200, BDS-SIS-ICD); the GPS SPS Performance Standard (2 revolutions per sidereal day: period
+11 h 58 min); the measured GPS orbit repeat time, about 245 s short of a solar day, i.e. ~86,155 s, a few
+seconds spread per satellite
 (Choi et al. 2004, GRL 31 L22608; Agnew and Larson 2007, GPS Solutions 11:71); the BDS definitions (GEO slots,
 IGSO equator crossings, MEO ground track repeating after 13 revolutions in 7 sidereal days).
 
@@ -17,7 +18,7 @@ from scipy.optimize import minimize_scalar
 
 from simkit.constellation import load
 
-MU = {"G": 3.986005e14, "C": 3.986004418e14}            # DESIGN.md: each system's own constants
+MU = {"G": 3.986005e14, "C": 3.986004418e14}            # each system's own constants (constellation/systems.py)
 OMEGA_E = {"G": 7.2921151467e-5, "C": 7.292115e-5}
 J2, RE = 1.08262668e-3, 6378137.0
 WEEK = 2416                                              # any week: nominal orbits are valid at every epoch

@@ -1,6 +1,6 @@
 """Broadcast-ephemeris orbits and clocks against RTKLIB's eph2pos (pyrtklib), GPS and BDS GEO/IGSO/MEO.
 
-Referee facts (shared/notes/pyrtklib.md): readrnx needs an uncompressed file; for BDS, RTKLIB keeps toe/toc in
+Referee facts (pyrtklib's behaviour): readrnx needs an uncompressed file; for BDS, RTKLIB keeps toe/toc in
 GPST; eph2pos takes GPST for every system; it decides GEO from the PRN (C01-C05, C59+), we from the orbit, so
 the agreement also checks our orbit-based GEO decision. RTKLIB is not used on RINEX 4 files.
 """

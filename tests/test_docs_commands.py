@@ -23,7 +23,7 @@ def quoted_commands() -> list[str]:
 @pytest.mark.slow
 @pytest.mark.parametrize("command", quoted_commands())
 def test_a_quoted_test_command_selects_tests(command):
-    """issue 19 (9): `pytest -s tests/test_gnss_doppler.py` ran no test (its only test is marked slow)."""
+    """Regression: `pytest -s tests/test_gnss_doppler.py` ran no test (its only test is marked slow)."""
     args = [a for a in shlex.split(command)[1:] if a != "-s"]
     args = [str(p) for a in args for p in (sorted(ROOT.glob(a)) if "*" in a else [a])]  # as a shell expands them
     proc = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-p", "no:cacheprovider", *args],

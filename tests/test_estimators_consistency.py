@@ -6,9 +6,10 @@ from scipy.spatial.transform import Rotation
 
 import simkit
 from simkit.estimators import FilterConfig, GnssFixes, ImuData, InitialState, KalmanFilter15
-from simkit.estimators.consistency import chi2_bounds, error_states, nees
 from simkit.estimators.model import enu_to_geodetic
 from simkit.frames import ecef_to_enu_vec, ecef_to_lla, enu_to_ecef_vec
+from simkit.referee.stats import mean_bounds, reduced_nees
+from studies.consistency import error_states
 
 RUNS = 50
 CFG = FilterConfig(gyro_arw=2.9e-5, accel_vrw=8.3e-4, p0_att=(0.005, 0.005, 0.02), p0_vel=0.1,
@@ -49,7 +50,7 @@ def _one_run(tr, rng):
     k = np.searchsorted(t, sol.t)
     e = error_states(sol, tr["truth/quat_nb"][k], tr["truth/vel_enu"][k], tr["truth/pos_lla"][k],
                      np.broadcast_to(bg, (k.size, 3)), np.broadcast_to(ba, (k.size, 3)))
-    return nees(e, sol.cov), sol.extras["nis"]
+    return reduced_nees(e, sol.cov)[0], sol.extras["nis"]
 
 
 def test_nees_and_nis_of_a_matched_filter_are_within_the_chi2_bounds(truth):
@@ -57,9 +58,9 @@ def test_nees_and_nis_of_a_matched_filter_are_within_the_chi2_bounds(truth):
     runs = [_one_run(truth, rng) for _ in range(RUNS)]
     avg_nees = np.mean([r[0] for r in runs], axis=0)
     avg_nis = np.mean([r[1] for r in runs], axis=0)
-    lo, hi = chi2_bounds(15, RUNS)
+    lo, hi = mean_bounds(15 * RUNS, RUNS)
     inside = np.mean((avg_nees > lo) & (avg_nees < hi))
-    lo6, hi6 = chi2_bounds(6, RUNS)
+    lo6, hi6 = mean_bounds(6 * RUNS, RUNS)
     inside_nis = np.mean((avg_nis > lo6) & (avg_nis < hi6))
     print(f"NEES: mean {avg_nees.mean():.2f} (15 expected), {inside:.0%} of epochs in [{lo:.2f}, {hi:.2f}]; "
           f"NIS: mean {avg_nis.mean():.2f} (6), {inside_nis:.0%} in [{lo6:.2f}, {hi6:.2f}]")

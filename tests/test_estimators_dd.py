@@ -16,10 +16,11 @@ from simkit.attitude.resolve import resolve
 from simkit.attitude.solvers import body_baselines
 from simkit.attitude.tight import group_rows
 from simkit.estimators import DDCarrier, EstimatorInputError, SOLVERS, model, nav
-from simkit.estimators.consistency import error_states, nees
-from simkit.estimators.dd_studies import truth_at
 from simkit.frames import attitude_from_euler
 from simkit.io import read_solution
+from simkit.referee.stats import reduced_nees
+from studies.consistency import error_states
+from studies.estimators_dd import truth_at
 from tests.cli_errors import assert_clean_error, run_cli
 
 
@@ -119,7 +120,7 @@ def test_kf15_dd_attitude_is_within_its_covariance_and_beats_kf15(xian):
         dd = sols["kf15_dd"]
         e = error_states(dd, *truth_at(ds, dd.t))
     m = dd.t >= 30.0
-    x = nees(e[m, 0:3], dd.cov[m, 0:3, 0:3])
+    x, _ = reduced_nees(e[m, 0:3], dd.cov[m, 0:3, 0:3])
     assert 1.0 < x.mean() < 9.0, x.mean()  # 3 dof; one run, errors correlated in time
     assert (dd.extras["dd_rows"][m] > 0).all()
     nis = dd.extras["dd_nis"][m] / dd.extras["dd_rows"][m]
@@ -184,7 +185,7 @@ def test_the_gate_keeps_a_corrupted_dd_epoch_out(xian):
 
 @pytest.mark.slow
 def test_kf15_dd_attitude_nees_is_within_the_chi2_bounds_over_a_monte_carlo(tmp_path):
-    from simkit.estimators.dd_studies import attitude_nees
+    from studies.estimators_dd import attitude_nees
 
     res = attitude_nees("airborne_stim300", runs=6, seconds=150.0, skip_s=60.0, workdir=tmp_path)
     lo, hi = res["bounds_95"]
@@ -192,7 +193,7 @@ def test_kf15_dd_attitude_nees_is_within_the_chi2_bounds_over_a_monte_carlo(tmp_
 
 
 def test_kf15_dd_on_a_static_site_aligns_automatically_from_the_fixed_attitude(xian):
-    """Issue 12: ``simkit solve xian.h5 --filter kf15_dd`` with no align key: "auto" takes the carrier-phase
+    """``simkit solve xian.h5 --filter kf15_dd`` with no align key: "auto" takes the carrier-phase
     attitude (3 antennas fix), reports it, and the heading is held to the DD level (a MEMS gyro cannot
     gyrocompass: "static" would start degrees off and the gate would reject the DD rows)."""
     proc = run_cli(["solve", str(xian), "--filter", "kf15_dd", "-q"], xian.parent)
@@ -239,7 +240,7 @@ def test_time_correlated_dd_noise_inflates_only_the_multipath_part(xian):
 def test_kf15_dd_attitude_nees_on_a_static_site_is_within_the_bounds_with_the_correlated_noise_model(tmp_path):
     """30 s Gauss-Markov carrier multipath on a static site: taken as white the DD update is optimistic (NEES
     4.4, 64 % inside at 10 x 600 s); with dd_correlation_s = 30 the mean is inside the bounds."""
-    from simkit.estimators.dd_studies import attitude_nees
+    from studies.estimators_dd import attitude_nees
 
     res = attitude_nees("xian_static_bds", runs=6, seconds=300.0, skip_s=60.0, workdir=tmp_path,
                         params={"dd_correlation_s": 30.0})

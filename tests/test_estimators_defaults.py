@@ -1,4 +1,4 @@
-"""Issue 19 items 2, 8, 10, 11: the estimators' defaults work on every bundled scenario, read no truth, and give
+"""The estimators' defaults work on every bundled scenario, read no truth, and give
 filters whose covariance matches their errors (NEES and NIS against the chi-square bounds of their dof).
 
 Each scenario is simulated once (shortened where the full length adds nothing but time) and every filter runs

@@ -1,4 +1,4 @@
-"""IMU increments in the estimators (issue 19, defect 1).
+"""IMU increments in the estimators.
 
 Authorities: closed forms of a steady roll (constant body rate, constant specific force in the navigation frame,
 so the exact body-frame increments are sin / cos integrals), a quadratic rate (exact integrals), and the file's

@@ -67,7 +67,7 @@ def test_non_positive_definite_innovation_is_flagged():
 
 
 def test_hinf_does_not_accept_a_nearly_singular_update():
-    # issue 19 item 10: p = 1, r = 1e4, alpha = 2 gives Wu's theta = (1 + p) / (alpha p) = 1 and an existence
+    # p = 1, r = 1e4, alpha = 2 gives Wu's theta = (1 + p) / (alpha p) = 1 and an existence
     # margin 1/p - theta + 1/r = 1e-4 > 0: the condition passes, but P+ = 1 / 1e-4 = 1e4 (10,000 times P).
     # The Kalman posterior is P_kf = 1 / (1/p + 1/r); the weighted rule keeps P+ <= alpha / (alpha - 1) P_kf.
     p, r, alpha = 1.0, 1e4, 2.0

@@ -1,4 +1,4 @@
-"""The 21-state filter's lever-arm estimate and the body rate of the lever-arm velocity (issue 19, kf21 on
+"""The 21-state filter's lever-arm estimate and the body rate of the lever-arm velocity (kf21 on
 airborne_stim300).
 
 Authorities: closed forms (the mean of a linear or quadratic rate over a window) and the truth of a synthetic

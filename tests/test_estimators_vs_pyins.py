@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 import simkit
-from simkit.estimators.evaluate import rms_table
-from simkit.estimators.peer import PARAMS, run_pyins
 from simkit.estimators.registry import SOLVERS, merged
+from studies.evaluate import rms_table
+from studies.pyins_peer import PARAMS, run_pyins
 
 AXES = ["pos_E", "pos_N", "pos_U", "vel_E", "vel_N", "vel_U", "pitch", "roll", "heading"]
 

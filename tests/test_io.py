@@ -160,6 +160,71 @@ def test_package_import_graph_is_acyclic():
     graphlib.TopologicalSorter(deps).prepare()
 
 
+# The declared layers, lowest first: a module imports only from layers below its own (and its own package).
+# Derived from the code: io needs no stage, validation (observability) needs only the geometry below it and is
+# used by attitude (ATDOP), ambiguity needs nothing but errors.
+LAYERS = [
+    {"errors", "version", "atomic", "rng", "gpstime", "processes", "earth", "solution"},
+    {"frames", "section", "params"},
+    {"trajectory", "imu", "constellation"},
+    {"gnss"},
+    {"io"},
+    {"scenario"},
+    {"pipeline"},
+    {"validation"},
+    {"ambiguity"},
+    {"attitude"},
+    {"estimators"},
+    {"referee"},
+    {"plots"},
+    {"campaign"},
+    {"commands"},
+    {"cli"},
+    {"__main__"},
+]
+# third-party packages only these sub-packages may import (None: none of simkit): the wheel runs without them
+CONFINED = {"pyins": None, "pandas": None, "matplotlib": "plots", "dask": "campaign", "distributed": "campaign"}
+
+
+def _package_edges():
+    """{(importing package, imported package): an example module} over every simkit import between packages
+    (the root package, the public API, left out)."""
+    def package(module):
+        parts = module.split(".")
+        return parts[1] if len(parts) > 1 else None
+
+    edges = {}
+    for module, imported in _graph().items():
+        src = package(module)
+        for dst in map(package, imported):
+            if None not in (src, dst) and dst != src:
+                edges.setdefault((src, dst), f"{module} imports simkit.{dst}")
+    return edges
+
+
+def test_every_import_goes_down_the_declared_layers():
+    rank = {name: i for i, layer in enumerate(LAYERS) for name in layer}
+    edges = _package_edges()
+    undeclared = {p for edge in edges for p in edge} - rank.keys()
+    assert not undeclared, f"place these in LAYERS: {sorted(undeclared)}"
+    upward = [why for (src, dst), why in edges.items() if rank[dst] >= rank[src]]
+    assert not upward, "\n".join(sorted(upward))
+
+
+def test_ambiguity_depends_on_nothing_but_errors():
+    assert {dst for src, dst in _package_edges() if src == "ambiguity"} <= {"errors"}
+
+
+def test_optional_and_lab_dependencies_stay_in_their_sub_package():
+    offenders = []
+    for path in PKG.rglob("*.py"):
+        sub = path.relative_to(PKG).parts[0]
+        for name in {n.split(".")[0] for n in _all_imports(path)} & CONFINED.keys():
+            if CONFINED[name] != sub:
+                offenders.append(f"{path.relative_to(ROOT)} imports {name}")
+    assert not offenders, "\n".join(sorted(offenders))
+
+
 def test_only_simkit_io_imports_h5py():
     offenders = [str(p.relative_to(ROOT)) for p in PKG.rglob("*.py")
                  if "h5py" in {n.split(".")[0] for n in _all_imports(p)} and p.parent.name != "io"]

@@ -83,7 +83,7 @@ def test_csv_in_gps_time_is_aligned_by_the_file_start(work):
     (["score", "q.h5", "q.h5", "--spec", "typo.toml"], "limits.position3d: unknown quantity (did you mean "),
     (["score", "q.h5", "q.h5", "--json", "nodir/s.json"], "--json: nodir/s.json: directory 'nodir' does not exist"),
     (["score", "est.csv", "q.h5"], "est.csv: not an HDF5 file"),
-    # issue 19 (6): an output is never an input of the same command
+    # an output is never an input of the same command
     (["score", "q.h5", "q.h5", "--json", "q.h5"], "--json: q.h5: is an input of this command"),
     (["score", "q.h5", "est.csv", "--json", "est.csv"], "--json: est.csv: is an input of this command"),
     (["score", "q.h5", "q.h5", "--spec", "pass.toml", "--json", "pass.toml"], "--json: pass.toml: is an input"),

@@ -1,4 +1,4 @@
-"""Solutions that do not estimate everything (issue 19, defect 5): NaN blocks of a covariance reduce the NEES
+"""Solutions that do not estimate everything: NaN blocks of a covariance reduce the NEES
 dimension (checked against scipy.stats.chi2 and the closed-form quadratic forms of each block); an Euler-only
 attitude with a NaN roll (two antennas) is scored on pitch and heading and says what it leaves out; the
 covariance of a filter's own error states (d_lat, d_lon, d_h, dv_*, phi_*) gives the +-3 sigma bands."""
@@ -120,3 +120,17 @@ def test_epochs_without_an_estimate_do_not_delay_convergence():
     assert stats.convergence_time(t, np.where(t == 9, 2.0, x), 1.0) is None
     assert stats.convergence_time(t, np.where(t >= 8, np.nan, np.where(t == 7, 2.0, x)), 1.0) is None
     assert stats.convergence_time(t, np.abs(x) * 0.1, 1.0) == 0.0
+
+
+def test_chi_square_bounds_of_a_mean_match_the_closed_forms_of_two_degrees_of_freedom():
+    """One chi-square value with 2 dof is exponential (mean 2): quantile -2 ln(1 - q). The mean of K such values
+    is Gamma(K, scale 2 / K). The NEES studies take their N-run bounds from the same function as the referee."""
+    from scipy.stats import gamma
+
+    from simkit.referee.stats import chi_square, mean_bounds
+
+    assert np.allclose(mean_bounds(2, 1, 0.95), (-2 * np.log(0.975), -2 * np.log(0.025)), rtol=1e-12)
+    lo, hi = mean_bounds(2 * 50, 50, 0.9)
+    assert np.allclose((lo, hi), gamma.ppf([0.05, 0.95], 50, scale=2 / 50), rtol=1e-10)
+    out = chi_square(np.full(50, 2.0), np.full(50, 2.0), 0.9)
+    assert np.allclose(out["mean_bounds"], (lo, hi), rtol=1e-12)

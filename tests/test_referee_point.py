@@ -1,4 +1,4 @@
-"""The point a solution estimates (issue 19, defect 3): the referee compares a solution with the truth at the
+"""The point a solution estimates: the referee compares a solution with the truth at the
 point it declares. Authorities: the file's own antenna truth (/gnss/truth/antenna_pos_ecef, antenna_vel_ecef,
 written by the GNSS stage), and SPP on error-free observations (noise and multipath off; the broadcast
 ionosphere correction is exact by design), which must land on its antenna to millimetres."""

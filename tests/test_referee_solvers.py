@@ -1,4 +1,4 @@
-"""Every solution simkit writes is scored and plotted (issue 19, defect 5): each solver of ``simkit solve`` on
+"""Every solution simkit writes is scored and plotted: each solver of ``simkit solve`` on
 shortened quickstart (two antennas: the attitude solvers give pitch and heading, roll NaN by design),
 airborne_stim300 and xian_static_bds; scoring states what a solution does not estimate, the filters' figures carry
 their +-3 sigma bands, and no figure is skipped."""

@@ -54,7 +54,7 @@ def test_regress_bad_input(tmp_path):
 
 
 def test_update_writes_a_user_file_and_leaves_the_bundled_one(tmp_path):
-    """issue 19 (9): `simkit regress --update` rewrote the golden file inside the installed package."""
+    """Regression: `simkit regress --update` rewrote the golden file inside the installed package."""
     from cli_errors import digest, run_cli
     from simkit.referee import regress
 

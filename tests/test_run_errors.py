@@ -120,7 +120,7 @@ def _solved(path: Path) -> None:
     ("solved.h5", _solved, "solved.h5: exists and holds /solutions"),
 ])
 def test_run_never_replaces_a_file_it_did_not_write(tmp_path, name, make, expect):
-    """issue 19 (6): `run -o` used to overwrite any file silently; now only a simkit file without /solutions
+    """Regression: `run -o` used to overwrite any file silently; now only a simkit file without /solutions
     (what a run writes), unless --force."""
     make(tmp_path / name)
     before = digest(tmp_path / name)
@@ -143,7 +143,7 @@ def test_run_replaces_its_own_output_and_anything_with_force(tmp_path):
 
 
 def test_rinex_name_stays_in_its_folder(tmp_path):
-    """issue 19 (6): `rinex --name ../evil` wrote outside its folder."""
+    """Regression: `rinex --name ../evil` wrote outside its folder."""
     import simkit
 
     simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=2"])
@@ -206,7 +206,7 @@ def test_unknown_command_and_option(tmp_path):
 
 
 def test_run_takes_overrides_as_a_dict(tmp_path):
-    """issue 19 (9): simkit.run(overrides=dict) failed with a command-line-worded error. A dict (dotted keys or
+    """Regression: simkit.run(overrides=dict) failed with a command-line-worded error. A dict (dotted keys or
     nested tables) gives the same file as the --set strings."""
     import numpy as np
 
@@ -229,7 +229,7 @@ def test_run_takes_overrides_as_a_dict(tmp_path):
 
 
 def test_an_error_inside_a_progress_bar_starts_its_own_line(tmp_path, monkeypatch):
-    """issue 19 (9): errors were printed on the progress bar's line ("solve:  50%|#####  | 1/2 simkit solve:
+    """Regression: errors were printed on the progress bar's line ("solve:  50%|#####  | 1/2 simkit solve:
     error: ..."). The bar is cleared first: the error line's text after the last carriage return is the error."""
     import contextlib
     import io

@@ -32,7 +32,7 @@ BAD = [
     (["--start", "2026-13-01"], "--start: expected an ISO 8601 UTC time"),
     (["--start", "1975-01-01T00:00:00Z"], "before the GPS epoch 1980-01-06"),
     (["--plot", "no/such/folder/sky.png"], "--plot: folder 'no/such/folder' does not exist"),
-    (["--plot", "sky.xyz"], "--plot: cannot tell the image type of 'sky.xyz'"),
+    (["--plot", "sky.xyz"], "--plot: sky.xyz: unknown image format 'xyz'"),
     (["no_such_nav_file.rnx"], "no_such_nav_file.rnx: no such file"),
     (["nominal:galileo"], "expected one of nominal:gps"),
 ]

@@ -69,7 +69,7 @@ def test_a_resolve_replaces_only_its_own_group(small):
      "estimator.attitude: expected one of wls, svd, badshah, baseline"),
     (["--filter", "tdcp", "--set", "estimator.lever_rate=gps"],
      "estimator.lever_rate: expected one of attitude, imu, got 'gps'"),
-    # issue 19 (4): one schema for every solver: booleans are never numbers, integers are not floats
+    # one schema for every solver: booleans are never numbers, integers are not floats
     (["--filter", "attitude", "--set", "estimator.mask_deg=true"], "estimator.mask_deg: expected a number, got True"),
     (["--filter", "kf15", "--set", "estimator.elevation_mask_deg=true"],
      "estimator.elevation_mask_deg: expected a number, got True"),
@@ -82,7 +82,7 @@ def test_a_resolve_replaces_only_its_own_group(small):
     (["--filter", "attitude", "--set", "estimator.stop_s=nan"], "estimator.stop_s: expected a finite number"),
     (["--filter", "kf15", "--set", "estimator.align=attitude"], "estimator.align: 'attitude' needs 3 or more"),
     (["--filter", "spp", "--filter", "attitude", "--set", "estimator.nosuch=1"], "estimator.nosuch: unknown key"),
-    # issue 19 (6): a solution name is one HDF5 group name
+    # a solution name is one HDF5 group name
     (["--filter", "spp", "--name", "../evil"], "--name: expected letters, digits"),
     (["--filter", "spp", "--name", "my sol"], "--name: expected letters, digits"),
     (["--filter", "spp", "--name", ".tmp"], "--name: expected letters, digits"),
@@ -94,7 +94,7 @@ def test_bad_arguments_fail_cleanly(small, args, expect):
 
 
 def test_every_filter_is_checked_before_any_runs(small):
-    """issue 19 (7): a bad value for the second filter leaves the file byte for byte as it was (it used to
+    """Regression: a bad value for the second filter leaves the file byte for byte as it was (it used to
     rewrite /solutions/spp first)."""
     before = digest(small)
     assert_clean_error(["solve", str(small), "--filter", "spp", "--filter", "kf15", "--set",
@@ -105,7 +105,7 @@ def test_every_filter_is_checked_before_any_runs(small):
 
 
 def test_a_filter_that_fails_on_its_data_writes_nothing_and_the_others_run(small):
-    """issue 19 (2): MC-LAMBDA needs 3 antennas and the file has 2 (/gnss/antennas/lever_arm_b): one line naming
+    """Regression: MC-LAMBDA needs 3 antennas and the file has 2 (/gnss/antennas/lever_arm_b): one line naming
     the filter, no /solutions/attitude_mc group, spp still written, exit 1."""
     with simkit.open(small) as ds:
         assert ds["gnss/antennas/lever_arm_b"].shape[0] == 2
@@ -181,9 +181,10 @@ def test_the_referee_reads_the_filter_states_with_their_own_definitions(small):
     """The referee's NEES over the navigation states of a kf15 solution (phi, dv, d_lat/d_lon/d_h by name, with
     the filter's sign and radian conventions) equals the NEES of the filter's own error definition."""
     from simkit.estimators import SOLVERS
-    from simkit.estimators.consistency import error_states, nees
     from simkit.referee.compare import compare
+    from simkit.referee.stats import reduced_nees
     from simkit.referee.truth import read_truth
+    from studies.consistency import error_states
 
     with simkit.open(small) as ds:
         sol = SOLVERS["kf15"](ds, {"gnss": "truth", "align": "static"}, False)
@@ -197,12 +198,12 @@ def test_the_referee_reads_the_filter_states_with_their_own_definitions(small):
         ref = error_states(sol, ds["truth/quat_nb"][:][k], ds["truth/vel_enu"][:][k], ds["truth/pos_lla"][:][k])
     cov = sol.cov[err.index][:, :9, :9]
     np.testing.assert_allclose(ours, ref[err.index][:, nav], rtol=1e-4, atol=1e-12)
-    np.testing.assert_allclose(nees(ours, cov), nees(ref[err.index][:, nav], cov), rtol=1e-3)
+    np.testing.assert_allclose(reduced_nees(ours, cov)[0], reduced_nees(ref[err.index][:, nav], cov)[0], rtol=1e-3)
 
 
 @pytest.mark.slow
 def test_a_cold_numba_cache_is_announced_once(small, tmp_path):
-    """issue 19 (9): the first `simkit solve` sat silent ~40 s while numba compiled. With an empty cache
+    """Regression: the first `simkit solve` sat silent ~40 s while numba compiled. With an empty cache
     (NUMBA_CACHE_DIR) the command says so; once the kernels are cached it does not."""
     import os
     import subprocess

@@ -58,14 +58,14 @@ def test_file_input_matches_scenario_input(tmp_path):
     (["validate", "missing.h5", "--set", "a=1"], "--set"),
     (["validate", "xian_static_bds", "--weighting", "bogus"], "--weighting"),
     (["validate", "xian_static_bds", "--systems", "G", *SHORT], "--systems: no satellite"),
-    (["validate", "xian_static_bds", "--json", "."], "--json: .: is a directory"),  # issue 19 (6): a traceback
+    (["validate", "xian_static_bds", "--json", "."], "--json: .: is a directory"),  # a traceback
 ])
 def test_bad_input_is_one_line(tmp_path, args, expect):
     assert_clean_error(args, tmp_path, expect=expect)
 
 
 def test_the_json_never_replaces_the_file_read(tmp_path):
-    """issue 19 (6): `validate F.h5 --json F.h5` replaced the file (truth and solutions lost)."""
+    """Regression: `validate F.h5 --json F.h5` replaced the file (truth and solutions lost)."""
     h5 = simkit.run("quickstart", out=tmp_path / "F.h5", overrides=["scenario.duration_s=2"])
     before = digest(h5)
     assert_clean_error(["validate", "F.h5", "--json", "F.h5"], tmp_path, expect="--json: F.h5: is an input")

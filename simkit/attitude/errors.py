@@ -1,17 +1,11 @@
 """The attitude package's bad-input error: names the argument, key or file and what was expected."""
 from __future__ import annotations
 
-from ..errors import SimkitError
+from ..errors import InputError
 
 
-class AttitudeInputError(SimkitError, ValueError):
+class AttitudeInputError(InputError):
     """Bad input to :mod:`simkit.attitude` (a wrong shape, an unknown parameter, a file without what is needed).
 
     ``what`` is the argument, parameter key or dataset path; the message says what was found and expected.
     """
-
-    exit_code = 2
-
-    def __init__(self, what: str, message: str):
-        self.what, self.message = what, message
-        super().__init__(f"{what}: {message}")

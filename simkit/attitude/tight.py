@@ -1,4 +1,4 @@
-"""Fixed double-differenced carrier as a measurement for a tightly coupled INS filter (issue 12 item 4).
+"""Fixed double-differenced carrier as a measurement for a tightly coupled INS filter (``kf15_dd``, docs/estimators.md).
 
 For each epoch whose ambiguities are fixed and validated (a full fix accepted by the ratio test, or held from
 such a fix by continuity), every DD channel of every baseline k (antenna k against antenna 0) gives

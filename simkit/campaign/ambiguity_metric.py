@@ -1,7 +1,7 @@
 """Single-epoch ambiguity success of one run: ILS on the double-differenced carrier and code of one antenna pair.
 
 For every epoch with at least ``min_dd`` double differences (DDs against the highest satellite of the signal's
-system, :mod:`simkit.gnss.differencing`), the float solution of :func:`simkit.ambiguity.experiments.float_solution`
+system, :mod:`simkit.gnss.differencing`), the float solution of :func:`simkit.gnss.differencing.float_solution`
 (DD carrier in cycles and code in m, unknown DD ambiguities and ENU baseline, equal-weight undifferenced noise
 with the run's median ``sigma_carrier`` / ``sigma_code``) is fixed by ILS (:func:`simkit.ambiguity.ils_batch`)
 and compared with the DDs of the true integer ambiguities ``/gnss/obs/<signal>/ambiguity``. The DD geometry row
@@ -16,8 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..ambiguity import bootstrap_success_rate, ils_batch
-from ..ambiguity.experiments import float_solution
-from ..gnss.differencing import double_difference, reference_satellites, systems_of
+from ..gnss.differencing import double_difference, float_solution, reference_satellites, systems_of
 from ..gnss.signals import SIGNALS
 from .registry import register
 

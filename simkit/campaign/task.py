@@ -54,8 +54,7 @@ def one_thread():
     """numba's parallel kernels on one thread for the calling thread, restored on exit.
 
     The runs are the parallelism of a campaign (one worker per core), so a run keeps to its own thread: its output
-    is compressed on it too (``threads=1``). On 2 cores this took 2 workers from 2.26 to 2.70 runs/s, with 1
-    worker unchanged (``python benchmarks/bench_campaign.py --runs 12 --duration 3600``).
+    is compressed on it too (``threads=1``); the gain is in docs/benchmarks.md.
     """
     previous = numba.get_num_threads()
     numba.set_num_threads(1)

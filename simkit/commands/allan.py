@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -35,23 +34,6 @@ def add_parser(sub):
     p.add_argument("--plot", metavar="OUT.png", help="save the ADEV plot (needs matplotlib: the 'plot' extra)")
     p.add_argument("--json", metavar="OUT", help="write the fitted terms as JSON")
     return p
-
-
-def _pyplot(out: str):
-    """matplotlib's pyplot (Agg), checking that it can write the format of ``out``."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise ScenarioError("--plot", "needs matplotlib: pip install 'simkit[plot]' (the plot extra)") from None
-    formats = plt.figure().canvas.get_supported_filetypes()
-    plt.close("all")
-    ext = Path(out).suffix.lstrip(".").lower()
-    if ext not in formats:
-        raise ScenarioError("--plot", f"{out}: unknown image format {ext!r} (one of {', '.join(sorted(formats))})")
-    return plt
 
 
 def _check_gauss_markov(n_gm: int):
@@ -105,7 +87,10 @@ def run(args) -> int:
         if out is not None:
             check_output(out, [args.file], option=option)
     _check_gauss_markov(args.gauss_markov)
-    plt = _pyplot(args.plot) if args.plot else None
+    if args.plot:
+        from ..plots import image_format
+
+        image_format(args.plot)
     dt, y, what, preset = _read(args)
     taus, dev, counts = adev(y, dt)
     flat = [axis for a, axis in enumerate("xyz") if not np.all(np.isfinite(dev[:, a])) or not np.any(dev[:, a] > 0)]
@@ -114,8 +99,10 @@ def run(args) -> int:
                                        f"non-finite Allan deviation; an ideal IMU? --raw analyses the measurement)")
     results = {axis: fit(taus, dev[:, a], counts, n_gm=args.gauss_markov) for a, axis in enumerate("xyz")}
     _print_table(args.sensor, f"{args.file}: {what}", dt, y.shape[0], preset, results)
-    if plt is not None:
-        _plot(plt, args.plot, taus, dev, results, args.sensor)
+    if args.plot:
+        from ..plots import allan_figure
+
+        allan_figure(args.plot, taus, dev, results, args.sensor, UNITS[args.sensor]["sigma"])
     if args.json:
         payload = {"file": args.file, "sensor": args.sensor, "rate_hz": 1 / dt, "units": UNITS[args.sensor],
                    "tau_s": taus.tolist(), "adev": dev.T.tolist(),
@@ -139,17 +126,3 @@ def _print_table(sensor, what, dt, n, preset, results):
         sys.stdout.flush()
     except BrokenPipeError:
         silence_stdout()  # the JSON and plot asked for are still written
-
-
-def _plot(plt, out, taus, dev, results, sensor):
-    fig, ax = plt.subplots(figsize=(7, 5))
-    for a, axis in enumerate("xyz"):
-        line, = ax.loglog(taus, dev[:, a], ".", label=f"{axis} measured")
-        ax.loglog(taus, results[axis].adev(taus), "-", color=line.get_color(), label=f"{axis} fit")
-    ax.set_xlabel("averaging time tau [s]")
-    ax.set_ylabel(f"Allan deviation [{UNITS[sensor]['sigma']}]")
-    ax.set_title(f"{sensor}: overlapping Allan deviation")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.savefig(out, dpi=120, bbox_inches="tight")
-    plt.close(fig)

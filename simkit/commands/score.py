@@ -51,7 +51,7 @@ def run(args) -> int:
     from .. import referee
 
     _check_outputs(args)
-    from ..io.output import check_outputs  # an output never replaces an input (issue 19)
+    from ..io.output import check_outputs  # an output never replaces an input
 
     check_outputs([("--json", args.json, False), ("--report", args.report, True)],
                   [args.file, args.estimate, args.spec])

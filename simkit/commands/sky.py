@@ -9,18 +9,16 @@ from __future__ import annotations
 
 import math
 import os
-import textwrap
 from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_open
 from ..errors import ScenarioError
 from . import silence_stdout
 
 MEMORY_LIMIT_BYTES = 2 * 1024**3
-# working memory of the geometry and DOPs: tracemalloc peak 206 B per satellite-epoch (67 and 24 satellites x
-# 4000 epochs), rounded up; the per-epoch part covers the time arrays. `python benchmarks/bench_constellation.py`
+# working memory of the geometry and DOPs per satellite-epoch: the measured peak rounded up (docs/benchmarks.md);
+# the per-epoch part covers the time arrays
 BYTES_PER_SAT_EPOCH = 256
 BYTES_PER_EPOCH = 64
 HEIGHT_RANGE_M = (-11000.0, 20.0e6)  # deepest ocean floor .. below the GNSS orbits
@@ -55,7 +53,7 @@ def run(args) -> int:
 
     _check_numbers(args)
     plot_format = _check_plot(args.plot) if args.plot else None
-    from ..io.output import check_outputs  # an output never replaces an input (issue 19)
+    from ..io.output import check_outputs  # an output never replaces an input
 
     check_outputs([("--plot", args.plot, False)], [args.source])
     start = _start(args.start)
@@ -67,8 +65,10 @@ def run(args) -> int:
     out = _Output()
     _print_table(out, const, args, week, sow, vis, d)
     if args.plot:
-        _sky_plot(args.plot, plot_format, const, geo, vis,
-                  f"{const.source} from {args.lat:.2f}, {args.lon:.2f}, {args.start}")
+        from ..plots import sky_figure
+
+        sky_figure(args.plot, plot_format, const, geo, vis,
+                   f"{const.source} from {args.lat:.2f}, {args.lon:.2f}, {args.start}")
         out.line(f"sky plot written to {args.plot}")
     return 0
 
@@ -98,17 +98,9 @@ def _check_plot(path_text: str) -> str:
         raise ScenarioError("--plot", f"folder {str(folder)!r} does not exist (create it first)")
     if not os.access(folder, os.W_OK):
         raise ScenarioError("--plot", f"folder {str(folder)!r} is not writable")
-    try:
-        from matplotlib.backend_bases import FigureCanvasBase
-    except ImportError:
-        raise ScenarioError("--plot", "needs matplotlib, which is not installed: pip install 'simkit[plot]' "
-                            "(the 'plot' extra)") from None
-    kinds = FigureCanvasBase.get_supported_filetypes()
-    kind = path.suffix.lower().lstrip(".")
-    if kind not in kinds:
-        raise ScenarioError("--plot", f"cannot tell the image type of {path.name!r}: expected a file name ending "
-                            f"in {', '.join('.' + k for k in sorted(kinds))}")
-    return kind
+    from ..plots import image_format
+
+    return image_format(path_text)
 
 
 def _start(text: str):
@@ -194,36 +186,3 @@ class _Output:
         except BrokenPipeError:
             self.closed = True
             silence_stdout()
-
-
-def _sky_plot(path, kind, const, geo, vis, title):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig = plt.figure(figsize=(8, 7), layout="constrained")
-    ax = fig.add_subplot(projection="polar")
-    ax.set_theta_zero_location("N")
-    ax.set_theta_direction(-1)
-    ax.set_rlim(90, 0)
-    colors = {"G": "tab:blue", "C": "tab:red"}
-    for s, sid in enumerate(const.sat_ids):
-        ok = vis[:, s]
-        if not ok.any():
-            continue
-        az, el = geo.azimuth[ok, s], np.degrees(geo.elevation[ok, s])
-        ax.plot(az, el, ".", ms=3, color=colors.get(sid[0], "k"))
-        ax.annotate(f"{sid} {const.orbit_type[s][0]}", (az[-1], el[-1]), fontsize=7)
-    for system, name in (("G", "GPS"), ("C", "BeiDou")):   # one legend entry per system drawn
-        if any(sid[0] == system and vis[:, s].any() for s, sid in enumerate(const.sat_ids)):
-            ax.plot([], [], ".", ms=6, color=colors[system], label=name)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="upper left", bbox_to_anchor=(0.98, 1.0), fontsize=8,
-                  title="labels: PRN, orbit\n(M MEO, I IGSO, G GEO)", title_fontsize=7)
-    # a long source path would run off the figure: wrap it
-    ax.set_title(textwrap.fill(title, 70) + "\nazimuth clockwise from north, radius elevation [deg]", fontsize=9,
-                 pad=14)
-    with atomic_open(path, "wb") as f:  # a failure never leaves a partial image under the name
-        fig.savefig(f, format=kind, dpi=120, bbox_inches="tight")
-    plt.close(fig)

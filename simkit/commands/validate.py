@@ -70,10 +70,9 @@ def _check_outputs(args):
         check_output(args.json, inputs, option="--json")
     if args.report:
         rep = check_output(args.report, inputs, option="--report", folder=True)
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
-            raise ScenarioError("--report", "needs matplotlib: pip install 'simkit[plot]'") from None
+        from ..plots import require_matplotlib
+
+        require_matplotlib("--report")
         return rep
     return None
 
@@ -100,7 +99,9 @@ def _write(args, v, report):
         rp.write_json(args.json, v.summary)
     if report is not None:
         report.mkdir(exist_ok=True)
-        figures = rp.plots(report, v)
+        from ..plots import validation_figures
+
+        figures = validation_figures(report, v)
         command = "simkit validate " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == \
             ["validate"] else ""
         text = rp.markdown(v, figures, command).encode()

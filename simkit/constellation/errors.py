@@ -1,18 +1,12 @@
 """The errors the constellation package raises for bad input (malformed files raise ``DataFileError``)."""
 from __future__ import annotations
 
-from ..errors import SimkitError
+from ..errors import InputError
 
 
-class ConstellationInputError(SimkitError, ValueError):
+class ConstellationInputError(InputError):
     """An argument is malformed: ``what`` names it (``"gps_week"``, ...); the message says what was found and
     what was expected."""
-
-    exit_code = 2
-
-    def __init__(self, what: str, message: str):
-        self.what, self.message = what, message
-        super().__init__(f"{what}: {message}")
 
 
 class NoStateError(ConstellationInputError):

@@ -27,7 +27,7 @@ class Geometry:
     ``tx_week`` (M, S) int and ``tx_sow`` (M, S) s: GPS emission time (reception minus geometric light time).
     ``sat_pos`` (M, S, 3) m and ``sat_vel`` (M, S, 3) m/s (None unless asked): satellite at emission, in the ECEF
     frame of reception. ``sat_pos_emission`` (M, S, 3) m: the same position in the ECEF frame of the emission
-    epoch (unrotated; RTKLIB ``satposs`` convention, DESIGN's ``/gnss/sat_pos_ecef``). ``sat_clock`` (M, S) s and ``sat_drift`` (M, S) s/s at emission. ``range`` (M, S) m
+    epoch (unrotated; RTKLIB ``satposs`` convention, what the file's ``/gnss/sat_pos_ecef`` stores). ``sat_clock`` (M, S) s and ``sat_drift`` (M, S) s/s at emission. ``range`` (M, S) m
     geometric distance, ``tau`` (M, S) s light time, ``los`` (M, S, 3) unit vectors receiver -> satellite (ECEF),
     ``elevation`` and ``azimuth`` (M, S) rad (azimuth clockwise from north in [0, 2 pi)).
     """

@@ -11,7 +11,7 @@ GPS-time seconds with BDT = GPST - 14 s, week + 1356). As in RTKLIB, a toe whose
 more than half a week is moved by one week.
 
 The parser is hand-written and vectorised over records (fixed-width fields sliced from the byte lines at once)
-because it is 22x faster than georinex on the same files (``python benchmarks/bench_constellation.py``).
+because it is much faster than georinex on the same files (figure in docs/benchmarks.md).
 """
 from __future__ import annotations
 

@@ -1,8 +1,9 @@
-"""Per-system constants for orbit and clock computation (DESIGN.md conventions).
+"""Per-system constants for orbit and clock computation.
 
 Each system's broadcast orbit uses its own gravitational constant and Earth rotation rate (IS-GPS-200 Table
 20-IV; BDS-SIS-ICD-B1I 5.2.4). The relativistic clock constant is F = -2 sqrt(mu) / c^2 (s / m^0.5).
-The fit half-widths are DESIGN.md's "state() semantics": GPS +-2 h, BDS +-1 h around toe.
+The fit half-widths are those of the ``state()`` semantics in docs/constellation.md: GPS +-2 h, BDS +-1 h
+around toe.
 """
 from __future__ import annotations
 

@@ -1,10 +1,8 @@
 """Bad input to the estimators: one error class naming the argument (or key) and what was expected."""
 from __future__ import annotations
 
-from ..errors import SimkitError
+from ..errors import InputError
 
 
-class EstimatorInputError(SimkitError, ValueError):
+class EstimatorInputError(InputError):
     """An estimator argument, ``--set estimator.*`` key or input file content is not what the filter needs."""
-
-    exit_code = 2

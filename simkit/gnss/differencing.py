@@ -9,15 +9,15 @@ of the DDs is D diag(sigma^2) D^T for independent undifferenced errors.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from ..errors import SimkitError
+from ..errors import InputError
 
 
-class DifferencingInputError(SimkitError, ValueError):
+class DifferencingInputError(InputError):
     """An array given to the differencing functions has the wrong shape (names the argument)."""
-
-    exit_code = 2
 
 
 def _obs(x, what: str = "x") -> np.ndarray:
@@ -108,3 +108,55 @@ def dd_covariance(sigma: np.ndarray, ref_sat: np.ndarray, valid: np.ndarray, ref
     d, ant, sat = dd_operator(ref_sat, valid, sigma.shape[0], ref_antenna)
     var = np.nan_to_num(np.asarray(sigma, dtype=float).reshape(-1) ** 2)
     return (d * var) @ d.T, ant, sat
+
+
+@dataclass(frozen=True)
+class FloatSolution:
+    """Float solution of T epochs for r baselines: a_hat (T, r n) cycles, b_hat (T, 3 r) m, Qa, Qb, Qba."""
+
+    a_hat: np.ndarray
+    b_hat: np.ndarray
+    Qa: np.ndarray
+    Qb: np.ndarray
+    Qba: np.ndarray
+
+
+def _between_satellite_cofactor(n):
+    """D D^T (n, n) of the between-satellite difference of n + 1 satellites: half the DD covariance of one antenna
+    pair with unit undifferenced sigma (:func:`dd_covariance`), I + 1 1^T."""
+    ref = np.zeros(n + 1, dtype=np.int64)  # satellite 0 is the reference; which one does not change D D^T
+    Q, _, _ = dd_covariance(np.ones((2, n + 1)), ref, np.ones(n + 1, bool))
+    return 0.5 * Q
+
+
+def float_solution(G, carrier_cycles, code_m, wavelength_m, sigma_phase_m, sigma_code_m) -> FloatSolution:
+    """Least-squares float solution of single-epoch DD carrier and code for r baselines from one master antenna.
+
+    ``G`` (T, n, 3): DD geometry rows (DD range = G b, m per m); ``carrier_cycles`` and ``code_m`` (T, r, n) DDs;
+    sigmas are of undifferenced observations (m). The DD noise of baseline k is D(e_k - e_master) with D the
+    between-satellite difference, so Cov(DD_k, DD_l) = (1 + [k == l]) sigma^2 D D^T; that Kronecker structure
+    gives the same estimator per baseline and Cov(x_k, x_l) = (1 + [k == l]) Qx0.
+    """
+    T, n, _ = G.shape
+    r = carrier_cycles.shape[1]
+    C0 = _between_satellite_cofactor(n)
+    Ci = np.linalg.inv(C0)
+    wp, wc = 1.0 / sigma_phase_m**2, 1.0 / sigma_code_m**2
+    lam = wavelength_m
+    # normal equations for x = [a (cycles); b (m)], carrier in metres = lam * carrier_cycles
+    N = np.zeros((T, n + 3, n + 3))
+    N[:, :n, :n] = lam**2 * wp * Ci
+    N[:, :n, n:] = lam * wp * Ci @ G
+    N[:, n:, :n] = np.swapaxes(N[:, :n, n:], 1, 2)
+    N[:, n:, n:] = (wp + wc) * np.swapaxes(G, 1, 2) @ Ci @ G
+    Qx0 = np.linalg.inv(N)
+    Qx0 = 0.5 * (Qx0 + np.swapaxes(Qx0, 1, 2))
+    phi_m = lam * carrier_cycles
+    rhs = np.concatenate([lam * wp * (phi_m @ Ci),
+                          (wp * phi_m + wc * code_m) @ Ci @ G], axis=2)  # (T, r, n + 3)
+    x = np.einsum("tij,trj->tri", Qx0, rhs)
+    S = np.eye(r) + np.ones((r, r))
+    Qa = np.einsum("kl,tij->tkilj", S, Qx0[:, :n, :n]).reshape(T, r * n, r * n)
+    Qb = np.einsum("kl,tij->tkilj", S, Qx0[:, n:, n:]).reshape(T, 3 * r, 3 * r)
+    Qba = np.einsum("kl,tij->tkilj", S, Qx0[:, n:, :n]).reshape(T, 3 * r, r * n)
+    return FloatSolution(x[:, :, :n].reshape(T, r * n), x[:, :, n:].reshape(T, 3 * r), Qa, Qb, Qba)

@@ -1,6 +1,6 @@
 """IMU error-model configuration: scenario keys (units in their names) -> SI parameters, and the bundled presets.
 
-Conventions (DESIGN.md): noise densities are two-sided PSD (IEEE Std 952); ``bias_instability_*`` is the IEEE
+Conventions (README, "Conventions"): noise densities are two-sided PSD (IEEE Std 952); ``bias_instability_*`` is the IEEE
 coefficient B of flicker noise, whose Allan-deviation floor is ``sqrt(2 ln 2 / pi) B = 0.664 B`` (vendors usually
 quote the floor itself: divide it by 0.664 to get B).
 """
@@ -77,7 +77,7 @@ class ImuConfig:
         return out
 
 
-# Scenario key -> (SensorSpec field, factor to SI), per sensor.  Units are in the key names (DESIGN.md).
+# Scenario key -> (SensorSpec field, factor to SI), per sensor.  Units are in the key names (README, "Conventions").
 _GYRO_KEYS = {
     "bias_turn_on_deg_per_h": ("bias_turn_on", DEG / HOUR),
     "bias_instability_deg_per_h": ("bias_instability", DEG / HOUR),

@@ -1,4 +1,4 @@
-"""Writing the simkit HDF5 file (schema v1, DESIGN.md): chunked, gzip-compressed, appended in time blocks.
+"""Writing the simkit HDF5 file (schema v1: :mod:`.schema`, README "HDF5 layout"): chunked, gzip-compressed, appended in time blocks.
 
 Time series are compressed chunk by chunk in a thread pool (byte shuffle + deflate level 1 in zlib format, which
 is what HDF5's shuffle and deflate filters read, so any HDF5 reader decodes them) and stored with direct chunk

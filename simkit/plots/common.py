@@ -9,13 +9,11 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..errors import SimkitError
+from ..errors import InputError, ScenarioError
 
 
-class PlotDependencyError(SimkitError):
+class PlotDependencyError(InputError):
     """matplotlib is missing: the ``plot`` extra is not installed."""
-
-    exit_code = 2
 
 
 def require_matplotlib(option: str = "plot"):
@@ -28,6 +26,19 @@ def require_matplotlib(option: str = "plot"):
     except ImportError:
         raise PlotDependencyError(f"{option}: needs matplotlib: pip install 'simkit[plot]' (the plot extra)") from None
     return plt
+
+
+def image_format(path, option: str = "--plot") -> str:
+    """The image type of ``path`` from its extension ("png", "pdf", ...), checked against what matplotlib can
+    write, before any work: a missing matplotlib or an unknown type is one error naming ``option``."""
+    plt = require_matplotlib(option)
+    kinds = plt.figure().canvas.get_supported_filetypes()
+    plt.close("all")
+    kind = Path(path).suffix.lower().lstrip(".")
+    if kind not in kinds:
+        raise ScenarioError(option, f"{path}: unknown image format {kind!r}: expected a file name ending in "
+                                    f"{', '.join('.' + k for k in sorted(kinds))}")
+    return kind
 
 
 def save(fig, path) -> None:

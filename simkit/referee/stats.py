@@ -164,12 +164,20 @@ def chi_square(value: np.ndarray, dof: np.ndarray, confidence: float = 0.95) -> 
     lo_q, hi_q = (1 - confidence) / 2, (1 + confidence) / 2
     dofs, which = np.unique(d, return_inverse=True)          # a few distinct dof: one ppf each
     inside = (v >= chi2.ppf(lo_q, dofs)[which]) & (v <= chi2.ppf(hi_q, dofs)[which])
-    k, total = int(ok.sum()), float(d.sum())
+    k = int(ok.sum())
     return {"epochs": k, "dof_mean": float(d.mean()) if k else float("nan"), "confidence": confidence,
             "fraction_inside": float(inside.mean()) if k else float("nan"),
             "mean": float(v.mean()) if k else float("nan"),
-            "mean_bounds": [float(chi2.ppf(lo_q, total) / k), float(chi2.ppf(hi_q, total) / k)] if k else None,
+            "mean_bounds": list(mean_bounds(float(d.sum()), k, confidence)) if k else None,
             "epoch_bounds": [float(chi2.ppf(lo_q, d.mean())), float(chi2.ppf(hi_q, d.mean()))] if k else None}
+
+
+def mean_bounds(total_dof: float, count: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Two-sided bounds at ``confidence`` of the mean of ``count`` independent chi-square values whose degrees of
+    freedom add up to ``total_dof`` (the mean over K epochs, or over N runs of one epoch: total_dof = N n):
+    chi2.ppf((1 -+ c) / 2, total_dof) / count."""
+    lo_q, hi_q = (1 - confidence) / 2, (1 + confidence) / 2
+    return float(chi2.ppf(lo_q, total_dof) / count), float(chi2.ppf(hi_q, total_dof) / count)
 
 
 def nis(err: Errors, extras: dict, confidence: float = 0.95) -> dict | None:
@@ -182,5 +190,5 @@ def nis(err: Errors, extras: dict, confidence: float = 0.95) -> dict | None:
     return out
 
 
-__all__ = ["STATE_SERIES", "STATS", "UNITS", "UNIT_OF", "chi_square", "convergence_time", "nees", "nis",
+__all__ = ["STATE_SERIES", "STATS", "UNITS", "UNIT_OF", "chi_square", "convergence_time", "mean_bounds", "nees", "nis",
            "not_estimated", "reduced_nees", "series", "sigma_bands", "statistics"]

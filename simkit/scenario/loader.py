@@ -18,6 +18,7 @@ import tomli_w
 
 from .. import gpstime
 from ..errors import ScenarioError
+from ..params import parse_value
 from ..gnss import GnssConfig, parse_config as parse_gnss
 from ..imu import ImuConfig, parse_config as parse_imu
 from ..section import Section, positive
@@ -67,14 +68,6 @@ class Scenario:
     source: str = ""
     data: dict = field(default_factory=dict)
     overrides: tuple = ()
-
-
-def parse_value(text: str):
-    """A ``--set`` value: a TOML literal (number, bool, string, array, inline table) or else a bare string."""
-    try:
-        return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
-        return text
 
 
 def apply_override(data: dict, assignment: str) -> None:

@@ -30,7 +30,7 @@ CHANNELS = ("accel", "pitch_rate", "turn_rate", "turn_accel", "roll_rate")
 
 @dataclass(frozen=True)
 class Truth:
-    """A block of truth at the sample times ``t`` (s since start); one field per /truth dataset (DESIGN.md)."""
+    """A block of truth at the sample times ``t`` (s since start); one field per /truth dataset (README, "HDF5 layout")."""
 
     t: np.ndarray
     pos_ecef: np.ndarray
@@ -68,9 +68,8 @@ def _cumulative(x0, f_nodes, f_mid, h):
     """Values at nodes (n+1) and midpoints (n) of x0 + integral of f, f given at nodes and midpoints.
 
     The same quadratic-per-interval rule as ``scipy.integrate.cumulative_simpson`` on the interleaved
-    node/midpoint grid (which agrees to roundoff), kept by hand because it is measured 10x faster: 0.43 ms
-    against 4.2 ms per 65,536-sample block (interleave + cumulative_simpson, scipy 1.17, 2-core CI machine);
-    a block makes 9 such calls, so scipy's would cost 2 s of the 4 s of ``benchmarks/bench_truth.py``.
+    node/midpoint grid (which agrees to roundoff), kept by hand because it is about 10x faster (figures in
+    docs/benchmarks.md).
     """
     full, half = _simpson_steps(f_nodes, f_mid, h)
     nodes = x0 + np.concatenate([[0.0], np.cumsum(full)])

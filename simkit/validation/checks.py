@@ -1,4 +1,5 @@
-"""Per-epoch checks of Wang 2018's claims C1-C3, C6 and the pair statistics of C7 (../shared/papers/README.md).
+"""Per-epoch checks of Wang 2018's claims C1-C3, C6 and the pair statistics of C7 (the claims are
+listed in docs/validation.md).
 
 Mathematical claims (C1-C3) are checked against an independent computation with a tolerance from the matrix
 condition; empirical claims (C6, C7) return which epochs / pairs hold, for fractions and counter-examples.

@@ -1,8 +1,6 @@
 """Bad input to the validation stage: one line naming the argument (or file and key) and what was expected."""
-from ..errors import SimkitError
+from ..errors import InputError
 
 
-class ValidationInputError(SimkitError, ValueError):
+class ValidationInputError(InputError):
     """An argument of :mod:`simkit.validation` has the wrong shape, is not finite, or names nothing usable."""
-
-    exit_code = 2

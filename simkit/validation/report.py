@@ -1,16 +1,12 @@
-"""The ``simkit validate`` outputs: JSON (the summary as is) and a Markdown report with PNG figures in the style
-of Wang 2018 Figs 2-5 (visible satellites; each ATDOP against its observable degree over the day)."""
+"""The ``simkit validate`` outputs: JSON (the summary as is) and a Markdown report that shows the PNG figures of
+:func:`simkit.plots.validation_figures` (Wang 2018 Figs 2-5)."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 
 from ..atomic import atomic_open
-
-ANGLES = (("pitch", "PIDOP"), ("roll", "RDOP"), ("yaw", "YDOP"))
-PLOT_STEP_S = 60.0      # one plotted point a minute keeps each PNG near 50 kB
 
 
 def write_json(path, summary: dict) -> None:
@@ -26,50 +22,6 @@ def _jsonable(x):
     if isinstance(x, float) and not np.isfinite(x):
         return None
     raise TypeError(f"not JSON: {type(x)}")
-
-
-def _thin(v):
-    step = max(1, int(round(PLOT_STEP_S / max(np.median(np.diff(v.t)) if len(v.t) > 1 else 1.0, 1e-9))))
-    return slice(None, None, step)
-
-
-def plots(folder: Path, v, config: str = "three") -> list[str]:
-    """Fig 2 (visible count) and Figs 3-5 (ATDOP and observable degree of each angle) for ``config`` with all
-    visible satellites; returns the file names written into ``folder``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    config = config if config in v.series else next(iter(v.series))
-    sl = _thin(v)
-    hours = v.t[sl] / 3600.0
-    names = []
-    fig, ax = plt.subplots(figsize=(6.4, 2.6))
-    ax.step(v.t / 3600.0, v.visible, where="post", lw=0.8)
-    ax.set(xlabel="hours since start", ylabel="visible satellites", title="Visible satellites (cf. Fig. 2)")
-    names.append(_save(fig, folder, "fig2_visible.png"))
-    atd, deg = v.series[config]
-    for a, (angle, dop) in enumerate(ANGLES):
-        fig, ax = plt.subplots(figsize=(6.4, 2.6))
-        ax.plot(hours, atd[sl, a], lw=0.8, color="tab:blue")
-        ax.set(xlabel="hours since start", ylabel=dop, title=f"{dop} and observable degree of {angle} "
-               f"({config}, all visible; cf. Fig. {3 + a})")
-        ax2 = ax.twinx()
-        ax2.plot(hours, deg[sl, a], lw=0.8, color="tab:red")
-        ax2.set_ylabel(f"observable degree ({angle})", color="tab:red")
-        names.append(_save(fig, folder, f"fig{3 + a}_{angle}.png"))
-    return names
-
-
-def _save(fig, folder: Path, name: str) -> str:
-    fig.tight_layout()
-    with atomic_open(folder / name, "wb") as f:
-        fig.savefig(f, format="png", dpi=72)
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
-    return name
 
 
 def _pct(x) -> str:

@@ -1,6 +1,7 @@
-"""Attitude error with fixed ambiguities against its predictions (issue 12, "ATDOP times the carrier noise").
+"""Attitude error with fixed ambiguities against its predictions ("ATDOP times the carrier noise",
+docs/attitude.md).
 
-``python -m simkit.attitude.atdop_study FILE [--set key=value ...]`` prints JSON: per axis [pitch, roll,
+``python -m studies.atdop FILE [--set key=value ...]`` prints JSON: per axis [pitch, roll,
 heading] the RMS error of the ``attitude`` solver's fixed epochs (status 1, single epoch) against /truth/euler,
 and its ratio to three predictions (RMS over the same epochs): the propagated covariance, Wang's unit-weight
 ATDOP x sigma_DD, and the weighted ATDOP (the actual DD covariance) x sigma_DD. ``--set`` goes to the solver.
@@ -12,7 +13,7 @@ import json
 
 import numpy as np
 
-from .solvers import solver
+from simkit.attitude.solvers import solver
 
 
 def ratios(ds, params: dict | None = None) -> dict:
@@ -37,12 +38,12 @@ def ratios(ds, params: dict | None = None) -> dict:
 
 
 def main(argv=None):
-    from ..io import open_dataset
-    p = argparse.ArgumentParser(prog="python -m simkit.attitude.atdop_study", description=__doc__.splitlines()[0])
+    from simkit.io import open_dataset
+    p = argparse.ArgumentParser(prog="python -m studies.atdop", description=__doc__.splitlines()[0])
     p.add_argument("file")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="attitude solver parameter")
     a = p.parse_args(argv)
-    from ..params import parse_set
+    from simkit.params import parse_set
 
     params = parse_set(a.set, prefix="")  # TOML literals, as simkit solve --set
     with open_dataset(a.file) as ds:

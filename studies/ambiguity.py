@@ -7,75 +7,21 @@ Simulated model (documented in docs/ambiguity.md), each piece replaceable:
 - observations: double differences against the highest satellite, between a master antenna and r others,
   ``carrier = G b / lambda + a + noise`` (cycles) and ``code = G b + noise`` (m), ``G = -(e_j - e_ref)``; the noise
   is undifferenced white noise (sigma_phase, sigma_code, no elevation weighting) pushed through the differencing,
-  so the DD covariance is exact. :func:`float_solution` takes any such DD observations (e.g. from simkit.gnss).
+  so the DD covariance is exact. :func:`simkit.gnss.differencing.float_solution` takes any such DD observations (e.g. from simkit.gnss).
 - baselines: length uniform in ``length_range_m``, heading uniform, elevation uniform in +-10 deg.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ..gnss.differencing import dd_covariance, double_difference, reference_satellites
-from ..gnss.signals import SIGNALS
-from ..rng import generator
-from .constrained import baseline_constrained_ils
-from .search import ils_batch
-from .success import bootstrap_success_rate
+from simkit.ambiguity.constrained import baseline_constrained_ils
+from simkit.ambiguity.search import ils_batch
+from simkit.ambiguity.success import bootstrap_success_rate
+from simkit.gnss.differencing import double_difference, float_solution, reference_satellites
+from simkit.gnss.signals import SIGNALS
+from simkit.rng import generator
 
 GPS_L1_WAVELENGTH_M = SIGNALS["L1C"].wavelength_m
-
-
-@dataclass(frozen=True)
-class FloatSolution:
-    """Float solution of T epochs for r baselines: a_hat (T, r n) cycles, b_hat (T, 3 r) m, Qa, Qb, Qba."""
-
-    a_hat: np.ndarray
-    b_hat: np.ndarray
-    Qa: np.ndarray
-    Qb: np.ndarray
-    Qba: np.ndarray
-
-
-def _between_satellite_cofactor(n):
-    """D D^T (n, n) of the between-satellite difference of n + 1 satellites: half the DD covariance of one antenna
-    pair with unit undifferenced sigma (simkit.gnss.differencing.dd_covariance), I + 1 1^T."""
-    ref = np.zeros(n + 1, dtype=np.int64)  # satellite 0 is the reference; which one does not change D D^T
-    Q, _, _ = dd_covariance(np.ones((2, n + 1)), ref, np.ones(n + 1, bool))
-    return 0.5 * Q
-
-
-def float_solution(G, carrier_cycles, code_m, wavelength_m, sigma_phase_m, sigma_code_m) -> FloatSolution:
-    """Least-squares float solution of single-epoch DD carrier and code for r baselines from one master antenna.
-
-    ``G`` (T, n, 3): DD geometry rows (DD range = G b, m per m); ``carrier_cycles`` and ``code_m`` (T, r, n) DDs;
-    sigmas are of undifferenced observations (m). The DD noise of baseline k is D(e_k - e_master) with D the
-    between-satellite difference, so Cov(DD_k, DD_l) = (1 + [k == l]) sigma^2 D D^T; that Kronecker structure
-    gives the same estimator per baseline and Cov(x_k, x_l) = (1 + [k == l]) Qx0.
-    """
-    T, n, _ = G.shape
-    r = carrier_cycles.shape[1]
-    C0 = _between_satellite_cofactor(n)
-    Ci = np.linalg.inv(C0)
-    wp, wc = 1.0 / sigma_phase_m**2, 1.0 / sigma_code_m**2
-    lam = wavelength_m
-    # normal equations for x = [a (cycles); b (m)], carrier in metres = lam * carrier_cycles
-    N = np.zeros((T, n + 3, n + 3))
-    N[:, :n, :n] = lam**2 * wp * Ci
-    N[:, :n, n:] = lam * wp * Ci @ G
-    N[:, n:, :n] = np.swapaxes(N[:, :n, n:], 1, 2)
-    N[:, n:, n:] = (wp + wc) * np.swapaxes(G, 1, 2) @ Ci @ G
-    Qx0 = np.linalg.inv(N)
-    Qx0 = 0.5 * (Qx0 + np.swapaxes(Qx0, 1, 2))
-    phi_m = lam * carrier_cycles
-    rhs = np.concatenate([lam * wp * (phi_m @ Ci),
-                          (wp * phi_m + wc * code_m) @ Ci @ G], axis=2)  # (T, r, n + 3)
-    x = np.einsum("tij,trj->tri", Qx0, rhs)
-    S = np.eye(r) + np.ones((r, r))
-    Qa = np.einsum("kl,tij->tkilj", S, Qx0[:, :n, :n]).reshape(T, r * n, r * n)
-    Qb = np.einsum("kl,tij->tkilj", S, Qx0[:, n:, n:]).reshape(T, 3 * r, 3 * r)
-    Qba = np.einsum("kl,tij->tkilj", S, Qx0[:, n:, :n]).reshape(T, 3 * r, r * n)
-    return FloatSolution(x[:, :, :n].reshape(T, r * n), x[:, :, n:].reshape(T, 3 * r), Qa, Qb, Qba)
 
 
 def sky_uniform_los(rng, n_sats, trials, mask_deg=10.0):

@@ -1,5 +1,5 @@
 """Single-epoch fix and wrong-fix rates per satellite count from a simkit file, beside the bootstrapped
-success-rate prediction (issue 12's xian_static_bds table). Validation is off (validation none): every epoch
+success-rate prediction (the xian_static_bds table of docs/attitude.md). Validation is off (validation none): every epoch
 is fixed, so fixed-correct / wrong-fix are the empirical success / failure rates of the estimator itself.
 """
 from __future__ import annotations
@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import binomtest
 
-from .. import ambiguity as amb
-from .dd import float_solution
-from .params import AMBIGUITY_DEFAULTS, merge
-from .reading import read
-from .solvers import SOLVER_NAMES, solver
+from simkit import ambiguity as amb
+from simkit.attitude.dd import float_solution
+from simkit.attitude.params import AMBIGUITY_DEFAULTS, merge
+from simkit.attitude.reading import read
+from simkit.attitude.solvers import SOLVER_NAMES, solver
 
 
 def fix_table(ds, names=("attitude", "attitude_c", "attitude_mc"), counts=(4, 5, 6, 7, 8, 9, 0), every=30,

@@ -1,4 +1,4 @@
-"""The figures of docs/estimators.md, each one command: ``python -m simkit.estimators.studies NAME [options]``.
+"""The figures of docs/estimators.md, each one command: ``python -m studies.estimators NAME [options]``.
 
 ``drift FILE [--seconds S]``      strapdown on the error-free truth rates of FILE vs the truth
 ``badshah FILE [--plot OUT.png]`` kf21 with / without the GNSS attitude, 10 deg initial heading error
@@ -19,11 +19,11 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..frames import ecef_to_enu_vec, ecef_to_lla
-from ..io import open_dataset
-from .evaluate import errors_vs_truth, rms_table
-from .registry import SOLVERS
-from .strapdown import strapdown
+from simkit.frames import ecef_to_enu_vec, ecef_to_lla
+from simkit.io import open_dataset
+from simkit.estimators.registry import SOLVERS
+from simkit.estimators.strapdown import strapdown
+from studies.evaluate import errors_vs_truth, rms_table
 
 WU_COLOURED = ["imu.gyro.gauss_markov=[{sigma_deg_per_h=0.5, tau_s=20.0}]",
                "imu.accel.gauss_markov=[{sigma_ug=200.0, tau_s=20.0}]"]
@@ -59,13 +59,13 @@ def badshah(path, plot=None, heading_error_deg=10.0) -> dict:
     with open_dataset(path) as ds:
         for use in (True, False):
             sol = SOLVERS["kf21"](ds, {**common, "use_attitude": use}, False)
-            dp, dv, de = errors_vs_truth(ds, sol)
+            t, dp, dv, de = errors_vs_truth(ds, sol)
             key = "with_attitude" if use else "without_attitude"
             h = np.degrees(np.abs(de[:, 2]))
-            curves[key] = (sol.t, np.degrees(de[:, 2]))
-            after = sol.t >= 100.0
-            out[key] = {f"heading_err_deg_at_{s}s": float(h[np.searchsorted(sol.t, s)]) for s in (10, 20, 30, 60)}
-            out[key]["first_time_below_0.5deg_s"] = float(sol.t[np.argmax(h < 0.5)]) if (h < 0.5).any() else None
+            curves[key] = (t, np.degrees(de[:, 2]))
+            after = t >= 100.0
+            out[key] = {f"heading_err_deg_at_{s}s": float(h[np.searchsorted(t, s)]) for s in (10, 20, 30, 60)}
+            out[key]["first_time_below_0.5deg_s"] = float(t[np.argmax(h < 0.5)]) if (h < 0.5).any() else None
             out[key]["vel_rms_after_100s_m_per_s"] = np.sqrt(np.mean(dv[after] ** 2, axis=0)).round(4).tolist()
             out[key]["pos_rms_after_100s_m"] = np.sqrt(np.mean(dp[after] ** 2, axis=0)).round(3).tolist()
     if plot:
@@ -76,7 +76,7 @@ def badshah(path, plot=None, heading_error_deg=10.0) -> dict:
 def spp_bias(path, antenna=0) -> dict:
     """SPP position error of antenna ``antenna`` vs its true phase centre (ENU mean and RMS, m), without
     (``ionosphere = none``) and with (``broadcast``) the file's Klobuchar correction."""
-    from .registry import DEFAULTS, spp_fixes
+    from simkit.estimators.registry import DEFAULTS, spp_fixes
 
     out = {}
     with open_dataset(path) as ds:
@@ -117,7 +117,7 @@ def _plot_heading(curves, out):
 def wu(runs=10, seed0=1, workdir=None, skip_s=10.0, coloured=True) -> dict:
     """Monte Carlo of KF vs H-infinity on high_dynamic with coloured IMU noise the filters do not model (or,
     with ``coloured`` False, with the preset's white noise and turn-on biases, which they model exactly)."""
-    from ..pipeline import run as simulate
+    from simkit.pipeline import run as simulate
 
     cols = ["pos_E_m", "pos_N_m", "pos_U_m", "vel_E_m_per_s", "vel_N_m_per_s", "vel_U_m_per_s", "pitch_deg",
             "roll_deg", "heading_deg"]
@@ -138,11 +138,11 @@ def wu(runs=10, seed0=1, workdir=None, skip_s=10.0, coloured=True) -> dict:
 
 
 def pyins_seeds(seeds, scenario="airborne_stim300", workdir=None, boot=5000) -> dict:
-    """kf15 against pyins over several seeds of ``scenario`` (:func:`simkit.estimators.peer.compare_pyins` per
+    """kf15 against pyins over several seeds of ``scenario`` (:func:`studies.pyins_peer.compare_pyins` per
     seed): the RMS over the runs of each filter's per-run RMS, their ratio with a 95 % bootstrap interval over the
     seeds, and on how many seeds simkit is at least as accurate, per axis."""
-    from ..pipeline import run as simulate
-    from .peer import compare_pyins
+    from simkit.pipeline import run as simulate
+    from studies.pyins_peer import compare_pyins
 
     ours, theirs = [], []
     with tempfile.TemporaryDirectory(dir=workdir) as d:
@@ -164,7 +164,7 @@ def pyins_seeds(seeds, scenario="airborne_stim300", workdir=None, boot=5000) -> 
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m simkit.estimators.studies", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog="python -m studies.estimators", description=__doc__.splitlines()[0])
     p.add_argument("study", choices=("drift", "badshah", "wu", "pyins", "spp"))
     p.add_argument("file", nargs="?")
     p.add_argument("--seconds", type=float)
@@ -184,7 +184,7 @@ def main(argv=None):
     elif a.file is None and a.seeds:
         res = pyins_seeds([int(x) for x in a.seeds.split(",")])
     else:
-        from .peer import compare_pyins
+        from studies.pyins_peer import compare_pyins
         res = compare_pyins(a.file)
     print(json.dumps(res, indent=1))
 

@@ -1,10 +1,10 @@
 """The kf15_dd figures of docs/estimators.md, each one command (JSON on stdout):
 
-``python -m simkit.estimators.dd_studies compare FILE [--skip S] [--set key=value ...]``
+``python -m studies.estimators_dd compare FILE [--skip S] [--set key=value ...]``
     pitch / roll / heading RMS against the file's truth (after ``--skip`` s) of kf15, kf15_dd and kf21 with
     the attitude solver's attitude (``attitude_source = "auto"``: the solver's attitude with 3+ antennas, else
     the truth plus noise; the source is printed); ``--set`` goes to all three filters.
-``python -m simkit.estimators.dd_studies nees SCENARIO [--runs N] [--seconds S] [--skip S] [--set ...]
+``python -m studies.estimators_dd nees SCENARIO [--runs N] [--seconds S] [--skip S] [--set ...]
 [--override scenario.key=value ...]``
     attitude NEES (3 dof, the phi block) of kf15_dd over ``N`` simulated runs (seeds 1..N) of SCENARIO against
     the two-sided 95 % chi-square bounds of an N-run average; prints the epoch-averaged mean and the fraction
@@ -20,18 +20,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import open_dataset
-from .consistency import chi2_bounds, error_states, nees
-from .evaluate import errors_vs_truth
-from .registry import SOLVERS
+from simkit.io import open_dataset
+from simkit.estimators.registry import SOLVERS
+from simkit.referee.stats import mean_bounds, reduced_nees
+from studies.consistency import error_states
+from studies.evaluate import errors_vs_truth
 
 RUNS = {"kf15": {}, "kf15_dd": {}, "kf21": {"attitude_source": "auto"}}
 
 
 def attitude_rms(ds, sol, skip_s: float) -> dict:
     """RMS (deg) of the pitch, roll and heading errors after ``skip_s`` s."""
-    _, _, de = errors_vs_truth(ds, sol)
-    m = sol.t >= skip_s
+    t, _, _, de = errors_vs_truth(ds, sol)
+    m = t >= skip_s
     r = np.degrees(np.sqrt(np.mean(de[m] ** 2, axis=0)))
     return {"pitch_deg": round(float(r[0]), 5), "roll_deg": round(float(r[1]), 5),
             "heading_deg": round(float(r[2]), 5), "epochs": int(m.sum())}
@@ -62,7 +63,7 @@ def truth_at(ds, t):
 def attitude_nees(scenario: str, runs: int = 10, seconds: float = 300.0, skip_s: float = 60.0,
                   params: dict | None = None, workdir=None, overrides=()) -> dict:
     """Monte Carlo attitude NEES of kf15_dd (see the module docstring)."""
-    from ..pipeline import run as simulate
+    from simkit.pipeline import run as simulate
 
     values = []
     with tempfile.TemporaryDirectory(dir=workdir) as d:
@@ -73,10 +74,10 @@ def attitude_nees(scenario: str, runs: int = 10, seconds: float = 300.0, skip_s:
                 sol = SOLVERS["kf15_dd"](ds, {**(params or {}), "seed": 1 + i}, False)
                 e = error_states(sol, *truth_at(ds, sol.t))
                 m = sol.t >= skip_s
-                values.append(nees(e[m, 0:3], sol.cov[m, 0:3, 0:3]))
+                values.append(reduced_nees(e[m, 0:3], sol.cov[m, 0:3, 0:3])[0])
     k = min(v.size for v in values)
     avg = np.mean([v[:k] for v in values], axis=0)
-    lo, hi = chi2_bounds(3, runs)
+    lo, hi = mean_bounds(3 * runs, runs)
     return {"scenario": scenario, "overrides": list(overrides), "runs": runs, "seconds": seconds, "skip_s": skip_s,
             "epochs": k,
             "nees_mean": round(float(avg.mean()), 3), "bounds_95": [round(lo, 3), round(hi, 3)],
@@ -84,13 +85,13 @@ def attitude_nees(scenario: str, runs: int = 10, seconds: float = 300.0, skip_s:
 
 
 def _params(pairs) -> dict:
-    from ..params import parse_set
+    from simkit.params import parse_set
 
     return parse_set(pairs or [], prefix="")  # TOML literals, as simkit solve --set
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m simkit.estimators.dd_studies", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog="python -m studies.estimators_dd", description=__doc__.splitlines()[0])
     p.add_argument("study", choices=("compare", "nees"))
     p.add_argument("target", help="a simkit file (compare) or a scenario name (nees)")
     p.add_argument("--skip", type=float, default=60.0, help="seconds left out of the statistics")

@@ -9,12 +9,12 @@ import time
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..frames import (SWAP, attitude_from_ned_frd, attitude_to_ned_frd, ecef_to_lla, euler_from_attitude,
+from simkit.frames import (SWAP, attitude_from_ned_frd, attitude_to_ned_frd, ecef_to_lla, euler_from_attitude,
                       lla_to_ecef)
-from ..io import open_dataset
-from ..solution import Solution
-from .evaluate import rms_table
-from .registry import SOLVERS, filter_config, gnss_fixes, imu_data, initial_state, merged
+from simkit.io import open_dataset
+from simkit.solution import Solution
+from simkit.estimators.registry import SOLVERS, filter_config, gnss_fixes, imu_data, initial_state, merged
+from studies.evaluate import rms_table
 
 PARAMS = {"gnss": "truth", "truth_pos_sigma_m": [1.0, 1.0, 1.0], "truth_vel_sigma_m_per_s": 0.05,
           "align": "truth", "init_heading_error_deg": 2.0, "p0_att_deg": [1.0, 1.0, 3.0], "p0_pos_m": [2.0, 2.0, 2.0],

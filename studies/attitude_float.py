@@ -1,6 +1,6 @@
-"""Fix rate of LAMBDA against the number of epochs in the float solution (issue 12 item 1, several epochs).
+"""Fix rate of LAMBDA against the number of epochs in the float solution (several epochs, docs/attitude.md).
 
-``python -m simkit.attitude.float_study FILE [--counts 5,6] [--windows 1,2,5,10] [--every 30] [--static]``
+``python -m studies.attitude_float FILE [--counts 5,6] [--windows 1,2,5,10] [--every 30] [--static]``
 prints a markdown table: per satellite count and window length N, the single-shot LAMBDA (ILS, no validation)
 fix and wrong-fix rates at every ``every``-th epoch (each float over the N epochs ending there) beside the mean
 bootstrapped success rate of the same floats. The floats treat the noise as white in time; the simulator's
@@ -13,11 +13,11 @@ import argparse
 import numpy as np
 from scipy.stats import binomtest
 
-from .dd import float_solution
-from .params import AMBIGUITY_DEFAULTS, merge
-from .reading import read
-from .resolve import resolve, subset
-from .solvers import _wrong, body_baselines
+from simkit.attitude.dd import float_solution
+from simkit.attitude.params import AMBIGUITY_DEFAULTS, merge
+from simkit.attitude.reading import read
+from simkit.attitude.resolve import resolve, subset
+from simkit.attitude.solvers import _wrong, body_baselines
 
 
 def window_rates(fd, count: int, windows, every: int = 30, static: bool = False, mask_deg: float = 10.0) -> list:
@@ -66,8 +66,8 @@ def format_rows(rows) -> str:
 
 
 def main(argv=None):
-    from ..io import open_dataset
-    p = argparse.ArgumentParser(prog="python -m simkit.attitude.float_study", description=__doc__.splitlines()[0])
+    from simkit.io import open_dataset
+    p = argparse.ArgumentParser(prog="python -m studies.attitude_float", description=__doc__.splitlines()[0])
     p.add_argument("file")
     p.add_argument("--counts", default="5,6")
     p.add_argument("--windows", default="1,2,5,10")

@@ -1,4 +1,5 @@
-"""Filter consistency against truth: the error state in the filter's own definitions, NEES and its chi^2 bounds.
+"""The filter's error state against truth, in the filter's own definitions (for NEES studies and tests; the
+NEES and its chi-square bounds are the referee's: :func:`simkit.referee.stats.reduced_nees`, :func:`~simkit.referee.stats.mean_bounds`).
 
 Error state (computed minus true, see :mod:`.model`): phi from C~ C^T = I - [phi x], dv = v~ - v,
 dp = [L~ - L, lambda~ - lambda, h~ - h], and for the sensor states the residual error left after the filter's
@@ -8,10 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.spatial.transform import Rotation
-from scipy.stats import chi2
 
-from ..frames import ecef_to_lla
-from ..solution import Solution
+from simkit.frames import ecef_to_lla
+from simkit.solution import Solution
 
 
 def error_states(sol: Solution, quat_nb, vel_enu, pos_lla, gyro_bias=None, accel_bias=None, lever_arm=None):
@@ -32,13 +32,3 @@ def error_states(sol: Solution, quat_nb, vel_enu, pos_lla, gyro_bias=None, accel
         e[:, 15:18] = sol.extras["lever_arm"] - (lever_arm if lever_arm is not None else 0.0)
     return e
 
-
-def nees(errors, cov):
-    """Normalised estimation error squared e^T P^-1 e per epoch, (K,)."""
-    return np.einsum("ki,ki->k", errors, np.linalg.solve(cov, errors[..., None])[..., 0])
-
-
-def chi2_bounds(dof: int, runs: int, level: float = 0.95):
-    """Two-sided bounds of the average of ``runs`` independent chi^2(dof) values."""
-    a = (1.0 - level) / 2.0
-    return chi2.ppf(a, dof * runs) / runs, chi2.ppf(1.0 - a, dof * runs) / runs
