@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from .version import __version__
 
-__all__ = ["__version__", "open", "run"]
+__all__ = ["__version__", "campaign", "open", "run", "score", "solve", "validate"]
 
 
 def run(scenario, out=None, seed=None, overrides=None, progress=False, force=False, threads=None):
@@ -21,3 +21,31 @@ def open(path):  # noqa: A001 - the documented API name
     from .io.reader import open_dataset
 
     return open_dataset(path)
+
+
+def solve(path, filters=None, params=None, progress=False, on_each=None):
+    """Run estimators on a simkit file: {filter name: Solution}; the file is only read (:func:`simkit.api.solve`)."""
+    from .api import solve as _solve
+
+    return _solve(path, filters=filters, params=params, progress=progress, on_each=on_each)
+
+
+def score(path, estimate, spec=None, solution=None, point=None):
+    """Errors of an estimate against the file's truth: a ``simkit.referee.Score`` (:func:`simkit.api.score`)."""
+    from .api import score as _score
+
+    return _score(path, estimate, spec=spec, solution=solution, point=point)
+
+
+def validate(scenario_or_path, **options):
+    """Wang 2018's observability claims on a scenario or a file (:func:`simkit.api.validate`, its options)."""
+    from .api import validate as _validate
+
+    return _validate(scenario_or_path, **options)
+
+
+def campaign(scenario, out, runs, **options):
+    """Monte Carlo runs of a scenario into a folder; returns the summary (:func:`simkit.api.campaign`)."""
+    from .api import campaign as _campaign
+
+    return _campaign(scenario, out, runs, **options)

@@ -178,6 +178,7 @@ LAYERS = [
     {"referee"},
     {"plots"},
     {"campaign"},
+    {"api"},
     {"commands"},
     {"cli"},
     {"__main__"},

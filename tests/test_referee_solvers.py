@@ -7,7 +7,7 @@ import pytest
 
 import simkit
 from simkit import referee
-from simkit.commands.solve import registry
+from simkit.api import registry
 from simkit.io import open_dataset, read_solution, write_solution
 from simkit.plots import file_figures
 

@@ -1,4 +1,5 @@
-"""``simkit campaign SCENARIO --runs N [--grid key=v1,v2 ...] [--workers W | --scheduler ADDRESS] -o DIR``."""
+"""``simkit campaign SCENARIO --runs N [--grid key=v1,v2 ...] [--workers W | --scheduler ADDRESS] -o DIR``: argument glue around
+:func:`simkit.api.campaign`."""
 from __future__ import annotations
 
 
@@ -30,11 +31,11 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..campaign import DEFAULT_METRICS, run_campaign
+    from ..api import campaign
 
-    s = run_campaign(args.scenario, args.out, args.runs, grid=args.grid, overrides=args.overrides,
-                     first_seed=args.first_seed, workers=args.workers, scheduler=args.scheduler,
-                     metrics=args.metrics or DEFAULT_METRICS, progress=not args.quiet, confidence=args.confidence)
+    s = campaign(args.scenario, args.out, args.runs, grid=args.grid, overrides=args.overrides,
+                 first_seed=args.first_seed, workers=args.workers, scheduler=args.scheduler, metrics=args.metrics,
+                 progress=not args.quiet, confidence=args.confidence)
     if not args.quiet:
         c = s["counts"]
         print(f"{c['completed']}/{c['planned']} runs complete ({c['skipped']} already done, {c['failed']} failed) "

@@ -1,5 +1,7 @@
 """``simkit score FILE.h5 ESTIMATE``: errors of an estimate (a /solutions group or a CSV) against the truth.
 
+Argument glue and reports around :func:`simkit.api.score`.
+
 Every check on the arguments and inputs runs before any computing; bad input is one line on stderr and exit 2.
 Exit code 1 when a spec is given and a check fails.
 """
@@ -7,8 +9,6 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-
-import numpy as np
 
 from ..errors import ScenarioError
 
@@ -49,6 +49,7 @@ def _check_outputs(args):
 
 def run(args) -> int:
     from .. import referee
+    from ..api import score_labelled
 
     _check_outputs(args)
     from ..io.output import check_outputs  # an output never replaces an input
@@ -60,11 +61,7 @@ def run(args) -> int:
         from ..plots import require_matplotlib
 
         require_matplotlib("--report")
-    sol, label = referee.load_estimate(args.estimate, args.solution, referee.file_start(args.file), args.point)
-    finite = np.asarray(sol.t, dtype=float)[np.isfinite(sol.t)]
-    span = (finite.min(), finite.max()) if finite.size else (None, None)
-    truth = referee.read_truth(args.file, *span)    # only the truth the estimate needs
-    sc = referee.score(truth, sol, spec, where=args.estimate)
+    sc, label = score_labelled(args.file, args.estimate, spec, args.solution, args.point)
     markdown = referee.to_markdown(sc, label, args.file)
     sys.stdout.write(markdown)
     if args.json:

@@ -2,16 +2,15 @@
 
 A scenario is simulated first, geometry only (trajectory and sky, no file written); a simkit file is read
 (/gnss/sat_pos_ecef, antenna positions, attitude). Exit 0 when the mathematical claims C1-C5 hold on every
-non-degenerate epoch, 1 when one fails, 2 for bad input (one line on stderr).
+non-degenerate epoch, 1 when one fails, 2 for bad input (one line on stderr). Argument glue and reports around
+:func:`simkit.api.validate`.
 """
 from __future__ import annotations
 
 import shlex
 import sys
-from pathlib import Path
 
 from ..atomic import atomic_open
-from ..errors import OutputError, ScenarioError
 from ..io.output import check_output
 
 
@@ -39,15 +38,12 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..validation import geometry
-    from ..validation.summary import validate
+    from ..api import check_validate, validate
 
+    check_validate(args.random, args.random_stride)
     report = _check_outputs(args)
-    geo = _geometry(args, geometry)
-    if args.systems:
-        geo = geometry.select_systems(geo, args.systems)
-    v = validate(geo, weighting=args.weighting, n_random=args.random, seed=args.seed,
-                 random_stride=args.random_stride, progress=not args.no_progress)
+    v = validate(args.input, args.set, systems=args.systems, weighting=args.weighting, n_random=args.random,
+                 random_stride=args.random_stride, seed=args.seed, progress=not args.no_progress)
     _write(args, v, report)
     claims = v.summary["claims"]
     for name, c in claims.items():
@@ -60,11 +56,7 @@ def run(args) -> int:
 
 
 def _check_outputs(args):
-    """Before any work: --random >= 0, --random-stride >= 1, the JSON and report paths (:func:`check_output`)."""
-    if args.random < 0:
-        raise ScenarioError("--random", f"found {args.random}; expected a count >= 0")
-    if args.random_stride < 1:
-        raise ScenarioError("--random-stride", f"found {args.random_stride}; expected an epoch step >= 1")
+    """Before any work: the JSON and report paths (:func:`check_output`)."""
     inputs = [args.input]
     if args.json:
         check_output(args.json, inputs, option="--json")
@@ -75,21 +67,6 @@ def _check_outputs(args):
         require_matplotlib("--report")
         return rep
     return None
-
-
-def _geometry(args, geometry):
-    from ..io import open_dataset
-    from ..scenario import load
-
-    path = Path(args.input)
-    if path.suffix.lower() in (".h5", ".hdf5"):
-        if args.set:
-            raise ScenarioError("--set", "applies to a scenario input, not to an HDF5 file")
-        if not path.is_file():
-            raise OutputError(path, "no such file")
-        with open_dataset(path) as ds:
-            return geometry.from_file(ds)
-    return geometry.from_scenario(load(args.input, args.set))
 
 
 def _write(args, v, report):

@@ -1,0 +1,241 @@
+"""The top-level API (re-exported as ``simkit.solve``, ``simkit.score``, ``simkit.validate``, ``simkit.campaign``).
+
+The commands of the same names are argument parsing and printing around these calls. Every call checks all of
+its input before computing anything; bad input raises a :class:`simkit.errors.SimkitError` (a ``ValueError``)
+naming the argument, key or file and what was expected.
+"""
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+import warnings
+
+from .errors import ScenarioError, SimkitError
+from .params import check_against_file, merge
+
+DEFAULT_FILTERS = ("spp", "kf15")
+KERNEL_FILTERS = ("kf15", "kf15_dd", "kf21", "hinf")
+
+
+def registry() -> dict:
+    """Every known filter name -> solver callable ``(ds, params, progress) -> Solution``: the estimators'
+    ``SOLVERS`` and, when that package exists, ``simkit.attitude.SOLVERS``."""
+    from .estimators import SOLVERS
+
+    out = dict(SOLVERS)
+    if importlib.util.find_spec("simkit.attitude") is not None:
+        out.update(getattr(importlib.import_module("simkit.attitude"), "SOLVERS", {}))
+    return out
+
+
+def defaults_of(name: str) -> dict | None:
+    """The parameter defaults of filter ``name``; None for a solver that declares none (it gets the parameters
+    no declared filter knows, unchecked)."""
+    from .estimators.registry import DEFAULTS
+
+    if name in DEFAULTS:
+        return DEFAULTS[name]
+    if importlib.util.find_spec("simkit.attitude.params") is None:
+        return None
+    from .attitude.params import AMBIGUITY_DEFAULTS, TDCP_DEFAULTS
+    from .attitude.solvers import SOLVER_NAMES
+
+    return TDCP_DEFAULTS if name == "tdcp" else AMBIGUITY_DEFAULTS if name in SOLVER_NAMES else None
+
+
+def check_filters(filters) -> list[str]:
+    """``filters`` (None: :data:`DEFAULT_FILTERS`) as a list, each a known name (:func:`registry`)."""
+    filters = list(filters) if filters is not None else list(DEFAULT_FILTERS)
+    known = registry()
+    for name in filters:
+        if name not in known:
+            raise ScenarioError("--filter", f"unknown filter {name!r} (known: {', '.join(sorted(known))})")
+    return filters
+
+
+def split_params(filters: list[str], params: dict) -> dict:
+    """Each filter's share of ``params``, every share checked (:func:`simkit.params.merge`) before any filter
+    runs: a filter with declared defaults takes the keys it declares; one without takes the keys no declared
+    filter knows. A key no requested filter can take is an error naming it."""
+    declared = {name: defaults_of(name) for name in filters}
+    known = set().union(*(d for d in declared.values() if d is not None))
+    if all(d is not None for d in declared.values()):
+        for key in params:
+            if key not in known:  # raises, naming the key and the keys of the first filter
+                merge(declared[filters[0]], {key: params[key]}, filters[0])
+    shares = {}
+    for name, defaults in declared.items():
+        if defaults is None:
+            shares[name] = {k: v for k, v in params.items() if k not in known}
+        else:
+            shares[name] = {k: v for k, v in params.items() if k in defaults}
+            merge(defaults, shares[name], name)
+    return shares
+
+
+def _check_file(path, filters, shares) -> None:
+    """The file opens as a simkit file, and each filter's values fit it (antenna index and count)."""
+    from .io import open_dataset
+
+    with open_dataset(path) as ds:
+        n_ant = ds["gnss/antennas/lever_arm_b"].shape[0] if "gnss/antennas/lever_arm_b" in ds else 0
+    for name in filters:
+        defaults = defaults_of(name)
+        if defaults is not None:
+            check_against_file(merge(defaults, shares[name], name), defaults, n_ant, path)
+
+
+def check_solve(path, filters=None, params=None) -> dict:
+    """Everything :func:`solve` checks before any filter runs; returns {filter name: its parameters}."""
+    filters = check_filters(filters)
+    shares = split_params(filters, dict(params or {}))
+    _check_file(path, filters, shares)
+    return shares
+
+
+def kernels_cold() -> bool:
+    """True when a numba kernel of the filter loop (:mod:`simkit.estimators.loop`, which compiles the Kalman and
+    H-infinity kernels it calls) has no valid on-disk cache yet: its first use compiles it, ~40 s of CPU. Reads
+    numba's cache index; False when numba's layout is not the expected one."""
+    from numba.core.dispatcher import Dispatcher
+
+    from .estimators import loop
+
+    kernels = [f for f in vars(loop).values() if isinstance(f, Dispatcher)]
+    try:
+        return any(not f._cache._cache_file._load_index() for f in kernels)
+    except (AttributeError, OSError):
+        return False
+
+
+def _solve_one(path, solver, share, progress):
+    """(Solution, None) or (None, why) for one filter; a failure on the file's data is its one-line reason."""
+    from .io import open_dataset
+
+    try:
+        with open_dataset(path) as ds:
+            return solver(ds, share, progress), None
+    except SimkitError as exc:
+        return None, str(exc)
+    except (ValueError, ArithmeticError, IndexError, KeyError) as exc:  # np.linalg.LinAlgError is a ValueError
+        return None, f"{type(exc).__name__}: {exc} (an internal error of the filter: please report it)"
+
+
+def _warn_failure(name, solution, why) -> None:
+    if solution is None:
+        warnings.warn(f"simkit.solve: {name}: failed: {why}", RuntimeWarning, stacklevel=3)
+
+
+def solve(path, filters=None, params=None, progress: bool = False, on_each=None) -> dict:
+    """Run estimators on the simkit HDF5 file ``path``; returns {filter name: :class:`simkit.solution.Solution`}.
+
+    ``filters``: names from :func:`registry` (estimators and attitude solvers; default ``spp`` and ``kf15``).
+    ``params``: {key: value} (the keys of ``simkit solve --set estimator.KEY=VALUE``, e.g. ``{"gnss": "truth"}``),
+    shared out by :func:`split_params` and checked with :mod:`simkit.params` against the file before any filter
+    runs (bad input raises). The file is only read: ``simkit solve`` writes each solution with
+    :func:`simkit.io.write_solution`. A filter that fails on the file's data is skipped (absent from the result)
+    and reported: ``on_each(name, solution_or_None, why_or_None)`` is called after each filter in order; without
+    it a failure is a ``RuntimeWarning``. ``progress``: a progress bar and the compile notice on stderr.
+    """
+    from tqdm import tqdm
+
+    filters = check_filters(filters)
+    shares, known = check_solve(path, filters, params), registry()
+    report = on_each or _warn_failure
+    out = {}
+    with tqdm(total=len(filters), unit="filter", desc="solve", leave=False, disable=not progress) as bar:
+        if progress and any(n in KERNEL_FILTERS for n in filters) and kernels_cold():
+            bar.write("solve: compiling the filter kernels (first run only, cached)", file=sys.stderr)
+        for name in filters:
+            bar.set_postfix_str(name)
+            sol, why = _solve_one(path, known[name], shares[name], progress)
+            if sol is not None:
+                out[name] = sol
+            report(name, sol, why)
+            bar.update()
+    return out
+
+
+def score(path, estimate, spec=None, solution: str | None = None, point: str | None = None):
+    """Errors of ``estimate`` against the truth of the simkit file ``path``: a :class:`simkit.referee.Score`.
+
+    ``estimate``: a simkit HDF5 file with /solutions (``path`` itself is fine; ``solution`` names the group when
+    there are several) or a CSV (columns: docs/referee.md; ``point``: ``imu``, ``antenna:K`` or
+    ``lever_b:[x,y,z]``, body frame x right, y forward, z up, m). ``spec``: pass/fail thresholds, a TOML path or
+    a :class:`simkit.referee.Spec` (``Score.passed``)."""
+    return score_labelled(path, estimate, spec, solution, point)[0]
+
+
+def score_labelled(path, estimate, spec=None, solution=None, point=None):
+    """:func:`score` and the estimate's label (for the reports): ``(Score, str)``."""
+    import numpy as np
+
+    from . import referee
+
+    if isinstance(spec, (str, bytes)) or hasattr(spec, "__fspath__"):
+        spec = referee.load_spec(spec)
+    sol, label = referee.load_estimate(estimate, solution, referee.file_start(path), point)
+    finite = np.asarray(sol.t, dtype=float)[np.isfinite(sol.t)]
+    span = (finite.min(), finite.max()) if finite.size else (None, None)
+    truth = referee.read_truth(path, *span)    # only the truth the estimate needs
+    return referee.score(truth, sol, spec, where=estimate), label
+
+
+def check_validate(n_random: int, random_stride: int) -> None:
+    """The counts of :func:`validate`, named by their command-line options."""
+    if n_random < 0:
+        raise ScenarioError("--random", f"found {n_random}; expected a count >= 0")
+    if random_stride < 1:
+        raise ScenarioError("--random-stride", f"found {random_stride}; expected an epoch step >= 1")
+
+
+def _geometry(scenario_or_path, overrides):
+    from pathlib import Path
+
+    from .errors import OutputError
+    from .io import open_dataset
+    from .scenario import load
+    from .validation import geometry
+
+    path = Path(scenario_or_path) if isinstance(scenario_or_path, (str, Path)) else None
+    if path is not None and path.suffix.lower() in (".h5", ".hdf5"):
+        if overrides:
+            raise ScenarioError("--set", "applies to a scenario input, not to an HDF5 file")
+        if not path.is_file():
+            raise OutputError(path, "no such file")
+        with open_dataset(path) as ds:
+            return geometry.from_file(ds)
+    return geometry.from_scenario(load(scenario_or_path, overrides or []))
+
+
+def validate(scenario_or_path, overrides=None, systems: str | None = None, weighting: str = "dd",
+             n_random: int = 1, random_stride: int = 10, seed: int = 0, progress: bool = False):
+    """Wang 2018's observability claims C1-C7 on a scenario (a TOML path, bundled name or dict: geometry only,
+    no file written) or a simkit HDF5 file: a :class:`simkit.validation.summary.Validation` (``.summary`` the
+    JSON of ``simkit validate``, ``.mathematical_failure`` True when C1-C5 fail somewhere).
+
+    ``overrides``: scenario ``--set`` items (scenario input only); ``systems``: RINEX letters, comma-separated;
+    ``weighting``: ``dd`` or ``identity``; ``n_random`` random orderings at every ``random_stride``-th epoch,
+    drawn from ``seed``."""
+    from .validation import geometry
+    from .validation.summary import validate as _validate
+
+    check_validate(n_random, random_stride)
+    geo = _geometry(scenario_or_path, overrides)
+    if systems:
+        geo = geometry.select_systems(geo, systems)
+    return _validate(geo, weighting=weighting, n_random=n_random, seed=seed, random_stride=random_stride,
+                     progress=progress)
+
+
+def campaign(scenario, out, runs: int, grid=(), overrides=(), first_seed: int = 0, workers=None, scheduler=None,
+             metrics=None, progress: bool = False, confidence: float = 0.95) -> dict:
+    """Monte Carlo runs of ``scenario`` into the folder ``out`` (one HDF5 file per run in ``out/runs``): the
+    summary also written to ``out/summary.json`` (:func:`simkit.campaign.run_campaign`; ``metrics`` default
+    :data:`simkit.campaign.DEFAULT_METRICS`). A re-run skips the runs already complete."""
+    from .campaign import DEFAULT_METRICS, run_campaign
+
+    return run_campaign(scenario, out, runs, grid=grid, overrides=overrides, first_seed=first_seed,
+                        workers=workers, scheduler=scheduler, metrics=metrics or DEFAULT_METRICS,
+                        progress=progress, confidence=confidence)
