@@ -160,8 +160,8 @@ def solve(path, filters=None, params=None, progress: bool = False, on_each=None)
 def score(path, estimate, spec=None, solution: str | None = None, point: str | None = None):
     """Errors of ``estimate`` against the truth of the simkit file ``path``: a :class:`simkit.referee.Score`.
 
-    ``estimate``: a simkit HDF5 file with /solutions (``path`` itself is fine; ``solution`` names the group when
-    there are several) or a CSV (columns: docs/referee.md; ``point``: ``imu``, ``antenna:K`` or
+    ``estimate``: a :class:`simkit.solution.Solution` (one of :func:`solve`'s, at the point it declares), a simkit
+    HDF5 file with /solutions (``path`` itself is fine; ``solution`` names the group when there are several) or a CSV (columns: docs/referee.md; ``point``: ``imu``, ``antenna:K`` or
     ``lever_b:[x,y,z]``, body frame x right, y forward, z up, m). ``spec``: pass/fail thresholds, a TOML path or
     a :class:`simkit.referee.Spec` (``Score.passed``)."""
     return score_labelled(path, estimate, spec, solution, point)[0]
@@ -175,11 +175,19 @@ def score_labelled(path, estimate, spec=None, solution=None, point=None):
 
     if isinstance(spec, (str, bytes)) or hasattr(spec, "__fspath__"):
         spec = referee.load_spec(spec)
-    sol, label = referee.load_estimate(estimate, solution, referee.file_start(path), point)
+    from .solution import Solution
+
+    if isinstance(estimate, Solution):
+        if solution is not None or point is not None:
+            raise ScenarioError("solution/point", "only for an estimate read from a file; a Solution declares its "
+                                                  "own point")
+        sol, label = estimate, "solution"
+    else:
+        sol, label = referee.load_estimate(estimate, solution, referee.file_start(path), point)
     finite = np.asarray(sol.t, dtype=float)[np.isfinite(sol.t)]
     span = (finite.min(), finite.max()) if finite.size else (None, None)
     truth = referee.read_truth(path, *span)    # only the truth the estimate needs
-    return referee.score(truth, sol, spec, where=estimate), label
+    return referee.score(truth, sol, spec, where=str(label if sol is estimate else estimate)), label
 
 
 def check_validate(n_random: int, random_stride: int) -> None:
