@@ -160,7 +160,7 @@ def main(argv=None) -> int:
     p.add_argument("--csv", help="also write pyins' native NED output as a CSV for `simkit score`")
     args = p.parse_args(argv)
     flt = PyinsLooselyCoupled()
-    res = referee.run(flt, args.file, duration_s=args.duration, progress=True)
+    res = referee.run_filter(flt, args.file, duration_s=args.duration, progress=True)
     if args.csv:
         write_native_csv(args.csv, *flt.native)
     referee.write_run_outputs(res, "pyins run_feedback_filter (loosely coupled)", args.file, args.json)

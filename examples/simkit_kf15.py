@@ -77,7 +77,7 @@ def main(argv=None) -> int:
     p.add_argument("--json", help="write the score and timing as JSON")
     p.add_argument("--report", help="directory for the Markdown report and error plots")
     args = p.parse_args(argv)
-    res = referee.run(SimkitKf15(), args.file, duration_s=args.duration, progress=True)
+    res = referee.run_filter(SimkitKf15(), args.file, duration_s=args.duration, progress=True)
     referee.write_run_outputs(res, "simkit KalmanFilter15 (loosely coupled)", args.file, args.json)
     if args.report:
         from simkit.plots import score_figures

@@ -161,8 +161,9 @@ def score(path, estimate, spec=None, solution: str | None = None, point: str | N
     """Errors of ``estimate`` against the truth of the simkit file ``path``: a :class:`simkit.referee.Score`.
 
     ``estimate``: a :class:`simkit.solution.Solution` (one of :func:`solve`'s, at the point it declares), a simkit
-    HDF5 file with /solutions (``path`` itself is fine; ``solution`` names the group when there are several) or a CSV (columns: docs/referee.md; ``point``: ``imu``, ``antenna:K`` or
-    ``lever_b:[x,y,z]``, body frame x right, y forward, z up, m). ``spec``: pass/fail thresholds, a TOML path or
+    HDF5 file with /solutions (``path`` itself is fine; ``solution`` names the group when there are several) or a
+    CSV (columns: docs/referee.md; ``point``: ``imu``, ``antenna:K`` or ``lever_b:[x,y,z]``, body frame x right,
+    y forward, z up, m). ``spec``: pass/fail thresholds, a TOML path or
     a :class:`simkit.referee.Spec` (``Score.passed``)."""
     return score_labelled(path, estimate, spec, solution, point)[0]
 

@@ -99,3 +99,26 @@ def test_validate_refuses_overrides_for_a_file_and_bad_counts(small):
         simkit.validate(small, overrides=["scenario.duration_s=10"])
     with pytest.raises(SimkitError, match="--random-stride"):
         simkit.validate(small, random_stride=0)
+
+
+def test_no_two_classes_of_simkit_share_a_name():
+    """Regression: two Truth, InitialState, Geometry and GaussMarkov classes meant an import decided which one a
+    reader got (examples/simkit_kf15.py converted referee's InitialState into the estimators' one)."""
+    import ast
+    import collections
+
+    where = collections.defaultdict(list)
+    for path in (README.parent / "simkit").rglob("*.py"):
+        for node in ast.parse(path.read_text()).body:
+            if isinstance(node, ast.ClassDef):
+                where[node.name].append(str(path.relative_to(README.parent)))
+    assert {name: paths for name, paths in where.items() if len(paths) > 1} == {}
+
+
+def test_the_plugin_runner_and_the_euler_atdop_have_names_of_their_own():
+    """``simkit.run`` simulates and ``simkit.validation.atdop(L)`` takes a Gramian: the referee's plugin runner
+    and the attitude's ATDOP from geometry are exported under other names."""
+    from simkit import attitude, referee, validation
+
+    assert "run" not in referee.__all__ and callable(referee.run_filter)
+    assert "atdop" not in attitude.__all__ and attitude.euler_atdop is not validation.atdop

@@ -4,7 +4,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from simkit import ambiguity as amb
-from simkit.attitude import (AttitudeInputError, Observations, atdop, badshah_eq10, float_solution,
+from simkit.attitude import (AttitudeInputError, Observations, badshah_eq10, euler_atdop, float_solution,
                              phi_covariance, resolve, single_baseline, wahba_svd)
 from simkit.attitude.tdcp import tdcp_velocity
 from simkit.attitude.wahba import propagated_covariance, wahba_wls
@@ -85,7 +85,7 @@ def test_atdop_equals_wang_eq22_gramian():
                   [0, l2 ** 2 * (sz ** 2).sum(), -l2 ** 2 * (sz * sy).sum()],
                   [-l1 ** 2 * (sz * sx).sum(), -l2 ** 2 * (sz * sy).sum(),
                    l1 ** 2 * (sx ** 2).sum() + l2 ** 2 * (sy ** 2).sum()]])
-    ours = atdop(np.eye(3)[None], Fw, s[None])[0]
+    ours = euler_atdop(np.eye(3)[None], Fw, s[None])[0]
     assert np.allclose(ours, np.sqrt(np.diag(np.linalg.inv(L))), rtol=1e-6)
 
 
@@ -296,9 +296,9 @@ def test_weighted_atdop_is_the_attitude_sd_of_the_weighted_fit_through_the_basel
     Qb = np.linalg.inv(Gb.T @ np.linalg.solve(Q, Gb))[None]
     sd = np.sqrt(np.diagonal(euler_covariance(R, phi_covariance(R, F, Qb)), axis1=1, axis2=2))
     s = np.sqrt(np.mean(np.diag(Q)))
-    assert np.allclose(atdop(R, F, G1, Q[None]) * s, sd, rtol=1e-6)
-    assert np.allclose(atdop(R, F, G1, np.eye(14)[None] * 3e-6), atdop(R, F, G1), rtol=1e-9)
-    assert not np.allclose(atdop(R, F, G1, Q[None]), atdop(R, F, G1), rtol=0.05)
+    assert np.allclose(euler_atdop(R, F, G1, Q[None]) * s, sd, rtol=1e-6)
+    assert np.allclose(euler_atdop(R, F, G1, np.eye(14)[None] * 3e-6), euler_atdop(R, F, G1), rtol=1e-9)
+    assert not np.allclose(euler_atdop(R, F, G1, Q[None]), euler_atdop(R, F, G1), rtol=0.05)
 
 
 def test_correlation_inflation_is_the_variance_of_the_mean_of_a_gauss_markov_sequence():

@@ -7,7 +7,7 @@ import pytest
 
 from simkit.imu import ImuSimulator
 from simkit.imu.allan import FLICKER_FLOOR, adev, fit, gm_avar, gm_peak
-from simkit.imu.config import GaussMarkov, ImuConfig, SensorSpec
+from simkit.imu.config import GaussMarkovConfig, ImuConfig, SensorSpec
 
 import allantools
 
@@ -65,7 +65,7 @@ def test_quantization():
 
 def test_gauss_markov_peak():
     sigma, t_corr = 1e-4, 5.0
-    y = gyro_errors(SensorSpec(gauss_markov=(GaussMarkov(sigma, t_corr),)), 10.0, 20000.0)
+    y = gyro_errors(SensorSpec(gauss_markov=(GaussMarkovConfig(sigma, t_corr),)), 10.0, 20000.0)
     tau_peak, adev_peak = gm_peak(sigma, t_corr)
     assert tau_peak == pytest.approx(1.89 * t_corr, rel=0.01)
     a = oadev(y, 10.0, [tau_peak])[0]
@@ -87,7 +87,7 @@ def test_our_adev_matches_allantools():
 def test_rate_independence(rate_hz):
     """The same physical spec gives the same ADEV at common tau (theory curve, within 5 %) at any rate."""
     spec = SensorSpec(random_walk=3e-5, bias_instability=1e-5, rate_random_walk=2e-7,
-                      gauss_markov=(GaussMarkov(2e-5, 0.5),))
+                      gauss_markov=(GaussMarkovConfig(2e-5, 0.5),))
     y = gyro_errors(spec, rate_hz, 1500.0, seed=11)
     taus = np.array([0.1, 0.3, 1.0, 3.0])
     _, a, _ = adev(y, 1.0 / rate_hz, taus)
@@ -99,7 +99,7 @@ def test_rate_independence(rate_hz):
 
 def test_rate_independence_pairwise():
     """100 Hz, 400 Hz and 1 kHz records of one spec agree with one another within 5 % at common tau."""
-    spec = SensorSpec(random_walk=3e-5, bias_instability=1e-5, gauss_markov=(GaussMarkov(2e-5, 0.5),))
+    spec = SensorSpec(random_walk=3e-5, bias_instability=1e-5, gauss_markov=(GaussMarkovConfig(2e-5, 0.5),))
     taus = np.array([0.1, 0.3, 1.0])
     curves = []
     for rate_hz in (100.0, 400.0, 1000.0):
@@ -143,7 +143,7 @@ def test_fit_recovers_q_and_n():
 
 def test_fit_recovers_gauss_markov_and_white():
     n, sigma, t_corr = 1e-4, 1e-4, 5.0
-    y = gyro_errors(SensorSpec(random_walk=n, gauss_markov=(GaussMarkov(sigma, t_corr),)), 10.0, 20000.0, seed=9)
+    y = gyro_errors(SensorSpec(random_walk=n, gauss_markov=(GaussMarkovConfig(sigma, t_corr),)), 10.0, 20000.0, seed=9)
     res = _fit_pooled(y, 10.0, terms=("N",), n_gm=1)
     assert res.N == pytest.approx(n, rel=0.15)
     (s_fit, t_fit), = res.gauss_markov

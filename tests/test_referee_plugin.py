@@ -43,7 +43,7 @@ class Recorder:
 
 def test_runner_feeds_samples_in_time_order_and_scores(air):
     rec = Recorder()
-    res = referee.run(rec, air, duration_s=10.0)
+    res = referee.run_filter(rec, air, duration_s=10.0)
     imu = [c for c in rec.calls if c[0] == "imu"]
     gnss = [c for c in rec.calls if c[0] == "gnss"]
     assert len(imu) == 1001 and len(gnss) == 11 and res.timing["imu_samples"] == 1001
@@ -60,18 +60,18 @@ def test_block_reading_gives_the_same_calls(air, monkeypatch, block):
     """The file is streamed in blocks of GNSS epochs: blocks of 1, 4 (0-3, 4-7, 8-10) or exactly all 11 epochs
     feed the filter exactly as one large block does."""
     whole = Recorder()
-    referee.run(whole, air, duration_s=10.0)
+    referee.run_filter(whole, air, duration_s=10.0)
     from simkit.referee import plugin
 
     monkeypatch.setattr(plugin, "BLOCK_EPOCHS", block)
     blocks = Recorder()
-    res = referee.run(blocks, air, duration_s=10.0)
+    res = referee.run_filter(blocks, air, duration_s=10.0)
     assert blocks.calls == whole.calls and res.timing["gnss_epochs"] == 11
 
 
 def test_a_filter_without_the_interface_is_named(air):
     with pytest.raises(referee.RefereeInputError, match="object has no predict, update, solution method"):
-        referee.run(object(), air)
+        referee.run_filter(object(), air)
 
 
 @pytest.mark.slow   # pyins' batch filter runs in pandas: about 10 s for 40 s of data
@@ -80,7 +80,7 @@ def test_pyins_loosely_coupled_end_to_end(air, tmp_path):
     from pyins_loosely_coupled import PyinsLooselyCoupled, write_native_csv
 
     flt = PyinsLooselyCoupled()
-    res = referee.run(flt, air)
+    res = referee.run_filter(flt, air)
     sc = res.score
     assert sc.meta["epochs_scored"] == 40
     # metre-level code fixes with their ionospheric delay: metres horizontally, a few tenths of a degree
@@ -120,7 +120,7 @@ def test_pyins_strapdown_of_an_ideal_imu_reproduces_the_truth(tmp_path):
         t, gyro, accel = ds["imu/t"][:], ds["imu/gyro"][:], ds["imu/accel"][:]
         lever = ds["gnss/antennas/lever_arm_b"][:]
     wrapper = PyinsLooselyCoupled()
-    wrapper.start(referee.InitialState(0.0, truth.pos_ecef[0], truth.vel_enu[0], truth.quat_nb[0], lever, 0, 0.0))
+    wrapper.start(referee.TrueInitialState(0.0, truth.pos_ecef[0], truth.vel_enu[0], truth.quat_nb[0], lever, 0, 0.0))
     imu = pd.DataFrame(np.hstack([frames.enu_to_ned(gyro), frames.enu_to_ned(accel)]), index=t,
                        columns=["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"])
     integrator = strapdown.Integrator(wrapper.initial_pva(t[0]))
@@ -146,8 +146,8 @@ def test_simkit_kf15_and_pyins_side_by_side_through_the_plugin(air):
     from pyins_loosely_coupled import PyinsLooselyCoupled
     from simkit_kf15 import SimkitKf15
 
-    ours = referee.run(SimkitKf15(), air)
-    theirs = referee.run(PyinsLooselyCoupled(), air)
+    ours = referee.run_filter(SimkitKf15(), air)
+    theirs = referee.run_filter(PyinsLooselyCoupled(), air)
     rows = []
     for name, res in (("simkit KF15", ours), ("pyins", theirs)):
         st = res.score.statistics

@@ -10,10 +10,10 @@ from .resolve import METHODS, Resolution, resolve
 from .solvers import build_registry
 from .tight import FixedDD, fixed_dd, read_fixed_dd
 from .velocity import solve_tdcp
-from .wahba import atdop, badshah_eq10, euler_covariance, phi_covariance, single_baseline, wahba_svd
+from .wahba import badshah_eq10, euler_atdop, euler_covariance, phi_covariance, single_baseline, wahba_svd
 
 SOLVERS = {**build_registry(), "tdcp": solve_tdcp}
 
 __all__ = ["AttitudeInputError", "FixedDD", "FloatGroup", "METHODS", "Observations", "Resolution", "SOLVERS",
-           "atdop", "badshah_eq10", "euler_covariance", "fixed_dd", "float_solution", "phi_covariance",
+           "badshah_eq10", "euler_atdop", "euler_covariance", "fixed_dd", "float_solution", "phi_covariance",
            "read_fixed_dd", "resolve", "single_baseline", "wahba_svd"]

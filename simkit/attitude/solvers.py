@@ -136,8 +136,8 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
         R, cov, _ = _attitude(res, F, method, p["attitude"])
         _store(out, grp, res, fd, R, cov)
         if not single:
-            out["atdop"][grp.epochs] = wahba.atdop(R, F, grp.G)
-            out["atdop_weighted"][grp.epochs] = wahba.atdop(R, F, grp.G, grp.Qphi)
+            out["atdop"][grp.epochs] = wahba.euler_atdop(R, F, grp.G)
+            out["atdop_weighted"][grp.epochs] = wahba.euler_atdop(R, F, grp.G, grp.Qphi)
     if single:
         out["euler"][:, 1] = np.nan
     return out, names

@@ -96,7 +96,7 @@ def single_baseline(b: np.ndarray, Qb: np.ndarray, f: np.ndarray):
     return pitch, heading, J @ Qb @ np.swapaxes(J, 1, 2)
 
 
-def atdop(R: np.ndarray, F: np.ndarray, G: np.ndarray, Q: np.ndarray | None = None) -> np.ndarray:
+def euler_atdop(R: np.ndarray, F: np.ndarray, G: np.ndarray, Q: np.ndarray | None = None) -> np.ndarray:
     """ATDOP (K, 3) [pitch, roll, heading] rad per metre of DD carrier noise: sqrt(diag(J L^-1 J')) with the
     Gramian L = H' H of the DD carrier rows H = G [-(R f_k) x] (unit weights; Wang 2018 eqs 8, 10-12, 16),
     through :func:`simkit.validation.atdop` of the Gramian in Euler coordinates, (J L^-1 J')^-1.

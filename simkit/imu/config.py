@@ -22,7 +22,7 @@ IDEAL = "ideal"
 
 
 @dataclass(frozen=True)
-class GaussMarkov:
+class GaussMarkovConfig:
     """A first-order Gauss-Markov process: stationary 1-sigma ``sigma`` (SI) and correlation time ``tau_s``."""
 
     sigma: float
@@ -42,7 +42,7 @@ class SensorSpec:
     bias_instability_tau_max_s: float = 1.0e4   # flicker band: longest correlation time
     random_walk: float = 0.0             # N: ARW rad/sqrt(s) | VRW m/s/sqrt(s)  (two-sided PSD N^2)
     rate_random_walk: float = 0.0        # K: rad/s/sqrt(s) | m/s^2/sqrt(s)
-    gauss_markov: tuple[GaussMarkov, ...] = ()
+    gauss_markov: tuple[GaussMarkovConfig, ...] = ()
     quantization: float = 0.0            # increment LSB: rad | m/s (IEEE Q = LSB / sqrt(12))
     scale_factor: float = 0.0            # 1-sigma, dimensionless (ppm * 1e-6)
     scale_factor_nonlinearity: float = 0.0   # error at full scale as a fraction of full scale
@@ -165,7 +165,7 @@ def _parse_sensor(sec: Section, name: str) -> SensorSpec:
     sigma_key, factor = _GM_SIGMA[name]
     gms = []
     for gm in sec.sections("gauss_markov"):
-        gms.append(GaussMarkov(gm.get(sigma_key, float, check=non_negative) * factor,
+        gms.append(GaussMarkovConfig(gm.get(sigma_key, float, check=non_negative) * factor,
                                gm.get("tau_s", float, check=positive)))
         gm.done()
     values["vibration_psd"] = _vibration_table(sec, name)

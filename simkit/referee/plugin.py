@@ -7,10 +7,10 @@ A filter is any object with
 - ``solution() -> simkit.solution.Solution``: its estimates in simkit conventions (ENU, body right-forward-up,
   scalar-last quaternions; :func:`simkit.referee.solution_from_ned` converts NED / forward-right-down outputs),
   with ``cov``/``state_names`` for the NEES test and ``nis``/``nis_dof`` extras for the NIS test;
-- optionally ``start(initial: InitialState)``: the true state at the first IMU sample, plus ``lever_arm_b``,
+- optionally ``start(initial: TrueInitialState)``: the true state at the first IMU sample, plus ``lever_arm_b``,
   for filters that are initialised externally (a referee run compares filters, not alignment procedures).
 
-:func:`run` feeds the file to the filter, times ``predict``, ``update`` and ``solution`` separately, and scores
+:func:`run_filter` feeds the file to the filter, times ``predict``, ``update`` and ``solution`` separately, and scores
 the solution against the truth (:func:`simkit.referee.score`). The interface is deliberately per sample: a
 filter that works in batches (pyins' ``run_feedback_filter``) buffers in ``predict``/``update`` and filters in
 ``solution``; its time then shows there.
@@ -65,7 +65,7 @@ class GnssEpoch:
 
 
 @dataclass(frozen=True)
-class InitialState:
+class TrueInitialState:
     """The true state at ``t``: ``pos_ecef`` (3,) m, ``vel_enu`` (3,) m/s, ``quat_nb`` (4,) body->ENU
     scalar-last, ``lever_arm_b`` (A, 3) m; ``start_gps_week``/``start_gps_sow`` the scenario start."""
 
@@ -126,7 +126,7 @@ def _check_filter(flt):
 def _start(flt, ds, truth, t0: float, start):
     if callable(getattr(flt, "start", None)):
         i = int(np.searchsorted(truth.t, t0))
-        flt.start(InitialState(float(truth.t[i]), truth.pos_ecef[i], truth.vel_enu[i], truth.quat_nb[i],
+        flt.start(TrueInitialState(float(truth.t[i]), truth.pos_ecef[i], truth.vel_enu[i], truth.quat_nb[i],
                                ds["gnss/antennas/lever_arm_b"][:], *start))
 
 
@@ -161,7 +161,8 @@ def _feed(flt, ds, t_imu, n: int, start, clock: dict, bar) -> int:
     return n_epochs
 
 
-def run(flt, path, spec: Spec | None = None, duration_s: float | None = None, progress: bool = False) -> RunResult:
+def run_filter(flt, path, spec: Spec | None = None, duration_s: float | None = None,
+               progress: bool = False) -> RunResult:
     """Run filter ``flt`` over the simkit file ``path`` (the first ``duration_s`` seconds, or all), time it and
     score its solution against the truth with ``spec``. The file is read in blocks of :data:`BLOCK_EPOCHS`."""
     _check_filter(flt)

@@ -29,7 +29,7 @@ CHANNELS = ("accel", "pitch_rate", "turn_rate", "turn_accel", "roll_rate")
 
 
 @dataclass(frozen=True)
-class Truth:
+class TrajectoryTruth:
     """A block of truth at the sample times ``t`` (s since start); one field per /truth dataset (README, "HDF5 layout")."""
 
     t: np.ndarray
@@ -52,9 +52,9 @@ class Truth:
         """Velocity relative to Earth in ECEF axes, (N, 3) m/s."""
         return frames.enu_to_ecef_vec(self.vel_enu, self.pos_lla[:, 0], self.pos_lla[:, 1])
 
-    def take(self, index) -> "Truth":
+    def take(self, index) -> "TrajectoryTruth":
         """The samples ``index`` (any numpy index along the time axis) of every field."""
-        return Truth(**{k: v[index] for k, v in self.arrays().items()})
+        return TrajectoryTruth(**{k: v[index] for k, v in self.arrays().items()})
 
 
 def _simpson_steps(f_nodes, f_mid, h):
@@ -97,7 +97,7 @@ class Trajectory:
                 out[name] += value
         return out
 
-    def blocks(self, rate_hz: float | None = None, block_samples: int = 1 << 16) -> Iterator[Truth]:
+    def blocks(self, rate_hz: float | None = None, block_samples: int = 1 << 16) -> Iterator[TrajectoryTruth]:
         """Truth at ``rate_hz`` (default the trajectory rate) in consecutive blocks of ``block_samples``."""
         rate = float(rate_hz or self.cfg.rate_hz)
         h = 1.0 / rate
@@ -146,7 +146,7 @@ class Trajectory:
         end = np.array([speed[-1], gamma[-1], psi[-1], rollx[-1], lat[-1], lon[-1], hgt[-1]])
         return truth, end
 
-    def _assemble(self, t, cmd, speed, gamma, psi, rollx, lat, lon, hgt) -> Truth:
+    def _assemble(self, t, cmd, speed, gamma, psi, rollx, lat, lon, hgt) -> TrajectoryTruth:
         gamma_dot, psi_dot = cmd["pitch_rate"], cmd["turn_rate"]
         cg, sg = np.cos(gamma), np.sin(gamma)
         cp, sp = np.cos(psi), np.sin(psi)
@@ -179,6 +179,6 @@ class Trajectory:
         f_ib_b = rot.inv().apply(f_n)
 
         pos_lla = np.stack([lat, lon, hgt], axis=-1)
-        return Truth(t=t, pos_ecef=frames.lla_to_ecef(lat, lon, hgt), pos_lla=pos_lla, vel_enu=vel_enu,
+        return TrajectoryTruth(t=t, pos_ecef=frames.lla_to_ecef(lat, lon, hgt), pos_lla=pos_lla, vel_enu=vel_enu,
                      quat_nb=rot.as_quat(), euler=frames.euler_from_attitude(rot), omega_ib_b=omega_ib_b,
                      f_ib_b=f_ib_b)

@@ -16,7 +16,7 @@ from .errors import ValidationInputError
 
 
 @dataclass(frozen=True)
-class Geometry:
+class ValidationGeometry:
     """What the validation needs, at M epochs and S satellites.
 
     ``t`` (M,) s since the start (GPS time ``week``, ``sow0`` s); ``sat_ids`` (S,); ``los_b`` (M, S, 3) unit
@@ -57,7 +57,7 @@ def body_los(sat_pos_ecef, rx_pos_ecef, quat_nb) -> tuple[np.ndarray, np.ndarray
     return np.einsum("mij,msj->msi", C_bn, u_enu), el
 
 
-def from_scenario(sc, progress: bool = False) -> Geometry:
+def from_scenario(sc, progress: bool = False) -> ValidationGeometry:
     """Geometry of scenario ``sc`` (a loaded :class:`simkit.scenario.Scenario`) at its GNSS rate: trajectory truth
     and the sky of ``sc.gnss.sources``; visible = elevation at or above ``sc.gnss.elevation_mask_rad``."""
     from ..constellation import load_sky
@@ -81,11 +81,11 @@ def from_scenario(sc, progress: bool = False) -> Geometry:
     with np.errstate(invalid="ignore"):
         vis = np.isfinite(el) & (el >= sc.gnss.elevation_mask_rad)
     arms = np.array([a.lever_arm_b for a in sc.gnss.antennas], dtype=float)
-    return Geometry(t, int(sc.start_week), float(sc.start_sow), tuple(sky.sat_ids), los, el, vis, arms,
+    return ValidationGeometry(t, int(sc.start_week), float(sc.start_sow), tuple(sky.sat_ids), los, el, vis, arms,
                     f"scenario {sc.name} ({', '.join(sky.sources)})")
 
 
-def from_file(ds) -> Geometry:
+def from_file(ds) -> ValidationGeometry:
     """Geometry of an open simkit file ``ds`` (:func:`simkit.open`): /gnss/sat_pos_ecef, antenna 0 of
     /gnss/truth/antenna_pos_ecef, /truth/quat_nb interpolated (slerp) to /gnss/t; visible = the satellite's
     carrier is tracked at every antenna on the first signal (else elevation above 0)."""
@@ -109,12 +109,12 @@ def from_file(ds) -> Geometry:
     if len(arms) < 2:
         raise ValidationInputError(f"{ds.path}: /gnss/antennas/lever_arm_b: expected at least 2 antennas, found "
                                    f"{len(arms)}")
-    return Geometry(t, int(ds.attrs.get("start_gps_week", 0)), float(ds.attrs.get("start_gps_sow", 0.0)),
+    return ValidationGeometry(t, int(ds.attrs.get("start_gps_week", 0)), float(ds.attrs.get("start_gps_sow", 0.0)),
                     tuple(ds["gnss/sat_id"][:].tolist()), los, el, vis & np.isfinite(el), arms,
                     f"file {ds.path.name} (scenario {ds.scenario_name})")
 
 
-def select_systems(geo: Geometry, systems: str) -> Geometry:
+def select_systems(geo: ValidationGeometry, systems: str) -> ValidationGeometry:
     """``geo`` restricted to the satellites whose id starts with one of ``systems`` (e.g. "C" for BDS, "G,C")."""
     letters = {s.strip().upper() for s in systems.split(",") if s.strip()}
     keep = np.array([sid[:1].upper() in letters for sid in geo.sat_ids], bool)
@@ -127,7 +127,7 @@ def select_systems(geo: Geometry, systems: str) -> Geometry:
                    source=f"{geo.source}, systems {','.join(sorted(letters))}")
 
 
-def every_nth(geo: Geometry, step: int) -> Geometry:
+def every_nth(geo: ValidationGeometry, step: int) -> ValidationGeometry:
     """``geo`` at every ``step``-th epoch (the same object for step 1)."""
     if step == 1:
         return geo

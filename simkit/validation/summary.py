@@ -48,7 +48,7 @@ def _kinds(n_random: int):
 
 def validate(geo, weighting: str = "dd", n_random: int = 1, seed: int = 0, random_stride: int = 10,
              progress: bool = False) -> Validation:
-    """Claims C1-C7 over every epoch of ``geo`` (:class:`~simkit.validation.geometry.Geometry`), for the dual
+    """Claims C1-C7 over every epoch of ``geo`` (:class:`~simkit.validation.geometry.ValidationGeometry`), for the dual
     and (with 3+ antennas) three-antenna configurations, every satellite count 2..visible, the highest subsets
     at every epoch and ``n_random`` random orderings drawn from ``seed`` at every ``random_stride``-th epoch
     (at 1 Hz the geometry barely moves in 10 s; 1 = every epoch)."""
