@@ -44,8 +44,11 @@ def validate(scenario_or_path, **options):
     return _validate(scenario_or_path, **options)
 
 
-def campaign(scenario, out, runs, **options):
-    """Monte Carlo runs of a scenario into a folder; returns the summary (:func:`simkit.api.campaign`)."""
-    from .api import campaign as _campaign
+def __getattr__(name):
+    """``simkit.campaign``: the campaign sub-package, callable as :func:`simkit.api.campaign` (imported on first
+    use: importing a sub-package rebinds its name in this package, so a function of that name would not stay)."""
+    if name == "campaign":
+        import importlib
 
-    return _campaign(scenario, out, runs, **options)
+        return importlib.import_module(".campaign", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -241,10 +241,11 @@ def validate(scenario_or_path, overrides=None, systems: str | None = None, weigh
 def campaign(scenario, out, runs: int, grid=(), overrides=(), first_seed: int = 0, workers=None, scheduler=None,
              metrics=None, progress: bool = False, confidence: float = 0.95) -> dict:
     """Monte Carlo runs of ``scenario`` into the folder ``out`` (one HDF5 file per run in ``out/runs``): the
-    summary also written to ``out/summary.json`` (:func:`simkit.campaign.run_campaign`; ``metrics`` default
-    :data:`simkit.campaign.DEFAULT_METRICS`). A re-run skips the runs already complete."""
-    from .campaign import DEFAULT_METRICS, run_campaign
+    summary also written to ``out/summary.json`` (:func:`simkit.campaign.run_campaign`; ``metrics`` None:
+    :data:`simkit.campaign.DEFAULT_METRICS`). A re-run skips the runs already complete. ``simkit.campaign`` is the
+    sub-package, made callable as this function."""
+    from .campaign import run_campaign
 
     return run_campaign(scenario, out, runs, grid=grid, overrides=overrides, first_seed=first_seed,
-                        workers=workers, scheduler=scheduler, metrics=metrics or DEFAULT_METRICS,
-                        progress=progress, confidence=confidence)
+                        workers=workers, scheduler=scheduler, metrics=metrics, progress=progress,
+                        confidence=confidence)

@@ -122,3 +122,18 @@ def test_the_plugin_runner_and_the_euler_atdop_have_names_of_their_own():
 
     assert "run" not in referee.__all__ and callable(referee.run_filter)
     assert "atdop" not in attitude.__all__ and attitude.euler_atdop is not validation.atdop
+
+
+def test_simkit_campaign_stays_callable_once_its_sub_package_is_imported(tmp_path):
+    """Regression: ``simkit.campaign`` was a function in simkit/__init__.py, and the first import of the
+    sub-package (by the call itself) rebound the name to the module: a second call raised TypeError."""
+    import importlib
+
+    from simkit.campaign import CampaignInputError
+
+    importlib.import_module("simkit.campaign.stats")
+    for _ in range(2):
+        with pytest.raises(CampaignInputError, match="--workers"):
+            simkit.campaign("quickstart", tmp_path / "c", 1, workers=0)
+    assert simkit.campaign.wilson_interval(5, 10)[0] < 0.5 < simkit.campaign.wilson_interval(5, 10)[1]
+    assert not (tmp_path / "c").exists()

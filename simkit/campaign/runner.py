@@ -151,14 +151,14 @@ def run_campaign(scenario, out_dir, runs: int, grid=(), overrides=(), first_seed
     """Run (or complete) a campaign into ``out_dir``; returns the summary also written to ``summary.json``.
 
     ``grid``: ["dotted.key=v1,v2", ...] (TOML literals, as ``--set``); ``runs`` seeds per grid point, from
-    ``first_seed``; ``overrides`` apply to every run; ``metrics`` registry names or ``module:function``.
+    ``first_seed``; ``overrides`` apply to every run; ``metrics`` registry names or ``module:function`` (None: the defaults).
     """
     t0 = time.perf_counter()
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise CampaignInputError("--workers", f"expected a positive integer, got {workers!r}")
     if not 0.0 < confidence < 1.0:
         raise CampaignInputError("--confidence", f"expected a number in (0, 1), got {confidence!r}")
-    metrics = tuple(metrics)
+    metrics = tuple(DEFAULT_METRICS if metrics is None else metrics)
     for name in metrics:
         get(name)
     specs = plan(scenario, runs, grid, first_seed, overrides)
