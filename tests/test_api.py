@@ -137,3 +137,16 @@ def test_simkit_campaign_stays_callable_once_its_sub_package_is_imported(tmp_pat
             simkit.campaign("quickstart", tmp_path / "c", 1, workers=0)
     assert simkit.campaign.wilson_interval(5, 10)[0] < 0.5 < simkit.campaign.wilson_interval(5, 10)[1]
     assert not (tmp_path / "c").exists()
+
+
+def test_score_takes_a_spec_as_a_toml_path_or_a_spec(small, tmp_path):
+    """A 1 nm limit on the horizontal error fails for any estimate from noisy pseudoranges; the path and the
+    loaded Spec give the same checks."""
+    from simkit import referee
+
+    spec = tmp_path / "zero.toml"
+    spec.write_text("[limits]\nhorizontal = { max_m = 1e-9 }\n")
+    sol = simkit.solve(small, filters=["spp"])["spp"]
+    by_path = simkit.score(small, sol, spec=spec)
+    assert not by_path.passed
+    assert by_path.checks == simkit.score(small, sol, spec=referee.load_spec(spec)).checks
