@@ -218,15 +218,15 @@ def _geometry(scenario_or_path, overrides):
     return geometry.from_scenario(load(scenario_or_path, overrides or []))
 
 
-def validate(scenario_or_path, overrides=None, systems: str | None = None, weighting: str = "dd",
-             n_random: int = 1, random_stride: int = 10, seed: int = 0, progress: bool = False):
+def validate(scenario_or_path, overrides=None, systems: str | None = None, *, n_random: int = 1,
+             random_stride: int = 10, **options):
     """Wang 2018's observability claims C1-C7 on a scenario (a TOML path, bundled name or dict: geometry only,
     no file written) or a simkit HDF5 file: a :class:`simkit.validation.summary.Validation` (``.summary`` the
     JSON of ``simkit validate``, ``.mathematical_failure`` True when C1-C5 fail somewhere).
 
     ``overrides``: scenario ``--set`` items (scenario input only); ``systems``: RINEX letters, comma-separated;
-    ``weighting``: ``dd`` or ``identity``; ``n_random`` random orderings at every ``random_stride``-th epoch,
-    drawn from ``seed``."""
+    ``n_random`` random orderings at every ``random_stride``-th epoch; ``options``: ``weighting`` (``dd`` or
+    ``identity``), ``seed``, ``progress`` of :func:`simkit.validation.summary.validate`."""
     from .validation import geometry
     from .validation.summary import validate as _validate
 
@@ -234,18 +234,15 @@ def validate(scenario_or_path, overrides=None, systems: str | None = None, weigh
     geo = _geometry(scenario_or_path, overrides)
     if systems:
         geo = geometry.select_systems(geo, systems)
-    return _validate(geo, weighting=weighting, n_random=n_random, seed=seed, random_stride=random_stride,
-                     progress=progress)
+    return _validate(geo, n_random=n_random, random_stride=random_stride, **options)
 
 
-def campaign(scenario, out, runs: int, grid=(), overrides=(), first_seed: int = 0, workers=None, scheduler=None,
-             metrics=None, progress: bool = False, confidence: float = 0.95) -> dict:
+def campaign(scenario, out, runs: int, **options) -> dict:
     """Monte Carlo runs of ``scenario`` into the folder ``out`` (one HDF5 file per run in ``out/runs``): the
-    summary also written to ``out/summary.json`` (:func:`simkit.campaign.run_campaign`; ``metrics`` None:
-    :data:`simkit.campaign.DEFAULT_METRICS`). A re-run skips the runs already complete. ``simkit.campaign`` is the
-    sub-package, made callable as this function."""
+    summary also written to ``out/summary.json``. ``options``: ``grid``, ``overrides``, ``first_seed``,
+    ``workers`` or ``scheduler``, ``metrics`` (None: :data:`simkit.campaign.DEFAULT_METRICS`), ``progress``,
+    ``confidence`` of :func:`simkit.campaign.run_campaign`. A re-run skips the runs already complete.
+    ``simkit.campaign`` is the sub-package, made callable as this function."""
     from .campaign import run_campaign
 
-    return run_campaign(scenario, out, runs, grid=grid, overrides=overrides, first_seed=first_seed,
-                        workers=workers, scheduler=scheduler, metrics=metrics, progress=progress,
-                        confidence=confidence)
+    return run_campaign(scenario, out, runs, **options)
