@@ -9,12 +9,29 @@ from __future__ import annotations
 
 import numpy as np
 import pymap3d
+from numba import njit
 from scipy.spatial.transform import Rotation
 
 from . import earth
 
 # ENU <-> NED and body right-forward-up <-> forward-right-down: the same proper rotation (it is its own inverse)
 SWAP = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+
+
+@njit(cache=True)
+def wrap(angle):
+    """Angles (rad; a float or an array of any shape) wrapped to [-pi, pi). Compiled, so the filter kernels and
+    the numpy callers share this one definition."""
+    return (angle + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def skew(v) -> np.ndarray:
+    """[v x] (..., 3, 3) of vectors ``v`` (..., 3), any frame and unit: skew(v) @ x == cross(v, x). (The filter
+    kernels use the compiled one-vector form ``simkit.estimators.nav.skew``.)"""
+    v = np.asarray(v, dtype=float)
+    z = np.zeros(v.shape[:-1])
+    x, y, w = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([np.stack([z, -w, y], -1), np.stack([w, z, -x], -1), np.stack([-y, x, z], -1)], -2)
 
 
 def lla_to_ecef(lat, lon, h):
@@ -81,6 +98,18 @@ def euler_from_attitude(rot: Rotation) -> np.ndarray:
         yzr = rot.as_euler("ZXY")
     heading = np.mod(-yzr[..., 0], 2.0 * np.pi)
     return np.stack([yzr[..., 1], yzr[..., 2], heading], axis=-1)
+
+
+def euler_jacobian(rot: Rotation, step: float = 1e-6) -> np.ndarray:
+    """(K, 3, 3) derivative of Euler [pitch, roll, heading] (rad) with respect to a small ENU rotation phi (rad),
+    C = exp([phi x]) C_b^n, at the K attitudes ``rot`` (body -> ENU), by central differences of ``step`` rad."""
+    cols = []
+    for axis in np.eye(3):
+        d = euler_from_attitude(Rotation.from_rotvec(step * axis) * rot) - euler_from_attitude(
+            Rotation.from_rotvec(-step * axis) * rot)
+        d[:, 2] = wrap(d[:, 2])  # only the heading can jump by 2 pi; wrapping tiny pitch/roll steps costs bits
+        cols.append(d / (2.0 * step))
+    return np.stack(cols, axis=-1)
 
 
 def enu_to_ned(vec):

@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from ..earth import OMEGA_E
+from ..frames import wrap
 from . import nav
 
 
@@ -102,11 +103,6 @@ def euler(c):
     roll = np.arctan2(-c[2, 0], c[2, 2])
     heading = np.arctan2(c[0, 1], c[1, 1]) % (2.0 * np.pi)
     return np.array([pitch, roll, heading])
-
-
-@njit(cache=True)
-def wrap(a):
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
 @njit(cache=True)
