@@ -100,6 +100,21 @@ def euler_from_attitude(rot: Rotation) -> np.ndarray:
     return np.stack([yzr[..., 1], yzr[..., 2], heading], axis=-1)
 
 
+def lever_arm_ecef(pos, vel, quat_nb, omega_ib_b, lever_b):
+    """Points at body-frame lever arms ``lever_b`` (A, 3) m from a body at ``pos`` (M, 3) m ECEF moving at ``vel``
+    (M, 3) m/s ECEF, with attitude ``quat_nb`` (M, 4) body -> ENU and inertial body rate ``omega_ib_b`` (M, 3)
+    rad/s: positions r + C_b^e l and velocities v + C_b^e ((w_ib^b - w_ie^b) x l), both (M, A, 3) ECEF, and C_b^e
+    (M, 3, 3)."""
+    lla = ecef_to_lla(pos)
+    c_en = ecef_to_enu_matrix(lla[:, 0], lla[:, 1])                       # C_e^n (M, 3, 3)
+    c_nb = Rotation.from_quat(np.asarray(quat_nb, dtype=float).reshape(-1, 4)).as_matrix()
+    c_be = np.einsum("mji,mjk->mik", c_en, c_nb)                          # C_b^e = (C_e^n)^T C_b^n
+    w_eb = np.asarray(omega_ib_b, dtype=float).reshape(-1, 3) - np.einsum("mji,j->mi", c_be, earth.EARTH_RATE_ECEF)
+    pos_l = pos[:, None, :] + np.einsum("mij,aj->mai", c_be, lever_b)
+    vel_l = vel[:, None, :] + np.einsum("mij,maj->mai", c_be, np.cross(w_eb[:, None, :], lever_b[None]))
+    return pos_l, vel_l, c_be
+
+
 def euler_jacobian(rot: Rotation, step: float = 1e-6) -> np.ndarray:
     """(K, 3, 3) derivative of Euler [pitch, roll, heading] (rad) with respect to a small ENU rotation phi (rad),
     C = exp([phi x]) C_b^n, at the K attitudes ``rot`` (body -> ENU), by central differences of ``step`` rad."""

@@ -92,3 +92,22 @@ def test_lines_of_sight_enu_are_the_local_vertical_and_horizon_directions():
     e, el = lines_of_sight_enu(rx, rx[:, None, :] + np.stack([up, north], 1))
     assert np.allclose(e, [[0, 0, 1], [0, 1, 0]], rtol=0, atol=1e-9)
     assert np.allclose(el, [[np.pi / 2, 0.0]] * 2, rtol=0, atol=1e-4)  # arcsin near 1: 1e-9 in e is 4e-5 rad
+
+
+def test_lever_arm_points_of_a_body_turning_with_the_earth_are_at_rest_in_ecef():
+    """A level body facing north (heading 0) at rest on the Earth senses w_ie only: its forward lever arm (0, l, 0)
+    lies l metres due north and does not move in ECEF; adding a yaw rate w about up moves it at w l due west."""
+    from simkit import earth
+
+    lat, lon = np.radians([45.0, -10.0]), np.radians([7.0, 120.0])
+    pos = frames.lla_to_ecef(lat, lon, np.zeros(2))
+    q = frames.quat_from_euler(np.zeros(2), np.zeros(2), np.zeros(2))
+    w_ie_b = earth.earth_rate_enu(lat)  # body axes = E, N, U at heading 0
+    lever = np.array([[0.0, 2.0, 0.0]])
+    p, v, _ = frames.lever_arm_ecef(pos, np.zeros((2, 3)), q, w_ie_b, lever)
+    north = frames.enu_to_ecef_vec(np.array([0.0, 1.0, 0.0]), lat, lon)
+    west = frames.enu_to_ecef_vec(np.array([-1.0, 0.0, 0.0]), lat, lon)
+    assert np.allclose(p[:, 0] - pos, 2.0 * north, rtol=0, atol=1e-9)
+    assert np.allclose(v[:, 0], 0.0, rtol=0, atol=1e-15)
+    _, v, _ = frames.lever_arm_ecef(pos, np.zeros((2, 3)), q, w_ie_b + [0.0, 0.0, 0.1], lever)
+    assert np.allclose(v[:, 0], 0.2 * west, rtol=0, atol=1e-15)
