@@ -13,7 +13,8 @@ PKG = Path(__file__).resolve().parents[1] / "simkit"
 
 # concept -> the modules allowed to define it; nav.skew is the compiled one-vector form the filter kernels call
 OWNERS = {"wrap": {"frames.py"}, "skew": {"frames.py", "estimators/nav.py"}, "euler_jacobian": {"frames.py"},
-          "sagnac_rotate": {"constellation/geometry.py"}}
+          "sagnac_rotate": {"constellation/geometry.py"}, "dd_operator": {"gnss/differencing.py"},
+          "dd_matrix": {"gnss/differencing.py"}}
 CONSTANTS = {"C_LIGHT", "OMEGA_E", "G0", "GM", "A", "F", "E2"}
 WGS84_OMEGA_E = 7.292115e-5  # rad/s, NIMA TR8350.2 table 3.1
 C = 299792458.0              # m/s, exact by the SI definition of the metre
@@ -111,3 +112,18 @@ def test_lever_arm_points_of_a_body_turning_with_the_earth_are_at_rest_in_ecef()
     assert np.allclose(v[:, 0], 0.0, rtol=0, atol=1e-15)
     _, v, _ = frames.lever_arm_ecef(pos, np.zeros((2, 3)), q, w_ie_b + [0.0, 0.0, 0.1], lever)
     assert np.allclose(v[:, 0], 0.2 * west, rtol=0, atol=1e-15)
+
+
+def test_dd_operator_from_any_reference_antenna_equals_the_double_differences():
+    from simkit.gnss.differencing import dd_operator, double_difference
+
+    rng = np.random.default_rng(4)
+    x = rng.normal(size=(1, 3, 6))
+    ref = np.array([[2, 2, 2, 5, 5, 5]])  # two systems, references 2 and 5
+    valid = np.array([True, True, True, False, True, True])
+    for ref_antenna in (0, 1, 2):
+        D, ant, sat = dd_operator(ref[0], valid, 3, ref_antenna)
+        dd = double_difference(x, ref, ref_antenna)[0]  # (A-1, S), antennas in order without the reference
+        rows = np.searchsorted(np.delete(np.arange(3), ref_antenna), ant)
+        assert np.allclose(D @ x[0].reshape(-1), dd[rows, sat], rtol=0, atol=1e-14)
+        assert sorted(set(sat)) == [0, 1, 4] and np.array_equal(ant, np.repeat(np.delete(np.arange(3), ref_antenna), 3))
