@@ -22,6 +22,7 @@ GAMMA_E = 9.7803253359             # normal gravity at the equator, m/s^2
 K_SOMIGLIANA = 0.00193185265241    # (b*gamma_p)/(a*gamma_e) - 1
 M_RATIO = OMEGA_E**2 * A**2 * B / GM  # 0.00344978650684
 C_LIGHT = 299792458.0              # m/s
+EARTH_RATE_ECEF = np.array([0.0, 0.0, OMEGA_E])  # w_ie^e, rad/s
 G0 = 9.80665                       # standard gravity, m/s^2: the unit behind "g", "mg", "ug" and load factors
 ELLIPSOID = pymap3d.Ellipsoid(A, B, name="WGS-84", model="wgs84")  # the same a and b, for pymap3d's geodesy
 

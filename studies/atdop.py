@@ -14,6 +14,7 @@ import json
 import numpy as np
 
 from simkit.attitude.solvers import solver
+from simkit.frames import wrap
 
 
 def ratios(ds, params: dict | None = None) -> dict:
@@ -23,7 +24,7 @@ def ratios(ds, params: dict | None = None) -> dict:
     tt = ds["truth/t"][:]
     truth = ds["truth/euler"][:][np.clip(np.searchsorted(tt, sol.t[fixed] - 1e-9), 0, len(tt) - 1)]
     d = sol.euler[fixed] - truth
-    d[:, 2] = (d[:, 2] + np.pi) % (2 * np.pi) - np.pi
+    d[:, 2] = wrap(d[:, 2])
     rms = np.sqrt(np.mean(d ** 2, axis=0))
     sig = sol.extras["sigma_dd_carrier"][fixed][:, None]
     pred = {"covariance": np.sqrt(np.mean(np.diagonal(sol.cov[fixed], axis1=1, axis2=2), axis=0)),

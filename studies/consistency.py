@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from simkit.frames import ecef_to_lla
+from simkit.frames import ecef_to_lla, wrap
 from simkit.solution import Solution
 
 
@@ -24,7 +24,7 @@ def error_states(sol: Solution, quat_nb, vel_enu, pos_lla, gyro_bias=None, accel
     e[:, 3:6] = sol.vel_enu - vel_enu
     lla = ecef_to_lla(sol.pos_ecef)
     e[:, 6:9] = lla - pos_lla
-    e[:, 7] = (e[:, 7] + np.pi) % (2 * np.pi) - np.pi
+    e[:, 7] = wrap(e[:, 7])
     if n >= 15:
         e[:, 9:12] = (gyro_bias if gyro_bias is not None else 0.0) - sol.extras["gyro_bias"]
         e[:, 12:15] = (accel_bias if accel_bias is not None else 0.0) - sol.extras["accel_bias"]

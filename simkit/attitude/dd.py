@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..gnss.differencing import systems_of
+from ..gnss.differencing import dd_matrix, systems_of
 from .errors import AttitudeInputError
 
 
@@ -117,18 +117,6 @@ def references(obs: Observations, usable: np.ndarray) -> np.ndarray:
         enough = usable[:, :, cols].sum(2) >= 2
         ref[:, :, cols] = np.where(enough, best, -1)[..., None]
     return ref
-
-
-def dd_operator(signal, sat, ref, n_ant: int, n_sat: int, n_sig: int) -> np.ndarray:
-    """D (r n, G A S) with DD = D x for x (G, A, S) flattened; rows baseline-major, then channel."""
-    n, r = len(sat), n_ant - 1
-    D = np.zeros((r, n, n_sig, n_ant, n_sat))
-    c = np.arange(n)
-    for k in range(1, n_ant):
-        for a, sign in ((k, 1.0), (0, -1.0)):
-            np.add.at(D[k - 1], (c, signal, a, sat), sign)
-            np.add.at(D[k - 1], (c, signal, a, ref), -sign)
-    return D.reshape(r * n, n_sig * n_ant * n_sat)
 
 
 def _patterns(usable, ref):
@@ -221,7 +209,7 @@ def _solve_group(obs: Observations, epochs, signal, sat, ref, correlated: bool =
     r, n = n_ant - 1, len(sat)
     sigs, sig_i = np.unique(signal, return_inverse=True)
     cols, col_i = np.unique(np.concatenate([sat, ref]), return_inverse=True)  # only the satellites used
-    D = dd_operator(sig_i, col_i[:n], col_i[n:], n_ant, len(cols), len(sigs))
+    D = dd_matrix(sig_i, col_i[:n], col_i[n:], n_ant, len(cols), len(sigs))
     lam = np.tile(obs.wavelength[signal], r)  # (r n,)
 
     def take(x):  # (G, M, A, S) -> (K, G' A S') in the column order of D

@@ -9,19 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..frames import ecef_to_enu_matrix, ecef_to_lla
-
-C_LIGHT = 299_792_458.0
-OMEGA_E = 7.2921151467e-5  # rad/s (GPS value; the BDS one differs by 1e-13 rad/s, negligible over 0.08 s)
-
-
-def sagnac_rotate(sat_pos: np.ndarray, receiver: np.ndarray) -> np.ndarray:
-    """Satellite positions (M, S, 3) m rotated by the Earth rotation over the travel time to ``receiver`` (M, 3)."""
-    tau = np.linalg.norm(sat_pos - receiver[:, None, :], axis=-1) / C_LIGHT
-    a = OMEGA_E * tau
-    c, s = np.cos(a), np.sin(a)
-    x, y = sat_pos[..., 0], sat_pos[..., 1]
-    return np.stack([c * x + s * y, -s * x + c * y, sat_pos[..., 2]], axis=-1)
+from ..constellation.geometry import lines_of_sight_enu, sagnac_rotate
+from ..earth import C_LIGHT
 
 
 def code_position(code: np.ndarray, sat_pos: np.ndarray, sat_clock: np.ndarray, iterations: int = 8) -> np.ndarray:
@@ -58,10 +47,4 @@ def _gauss_newton(rho, sp, w, x, iterations):
 
 def lines_of_sight(receiver: np.ndarray, sat_pos: np.ndarray):
     """Unit lines of sight receiver -> satellite in ENU (M, S, 3) and elevations (M, S) rad, Sagnac applied."""
-    s = sagnac_rotate(sat_pos, receiver)
-    d = s - receiver[:, None, :]
-    e_ecef = d / np.linalg.norm(d, axis=-1, keepdims=True)
-    lla = ecef_to_lla(receiver)
-    R = ecef_to_enu_matrix(lla[:, 0], lla[:, 1])  # (M, 3, 3) rows E, N, U
-    e = np.einsum("mij,msj->msi", R, e_ecef)
-    return e, np.arcsin(np.clip(e[..., 2], -1.0, 1.0))
+    return lines_of_sight_enu(receiver, sagnac_rotate(sat_pos, receiver))

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..earth import OMEGA_E
-from .wahba import skew
+from ..frames import skew
 
 
 def lever_velocity_differenced(R0, R1, E0, E1, lever_b, dt, P0=None, P1=None):

@@ -5,9 +5,10 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..frames import euler_from_attitude
+from ..gnss.differencing import dd_matrix
 from ..solution import Solution
 from . import wahba
-from .dd import FloatGroup, dd_operator, float_solution, run_breaks
+from .dd import FloatGroup, float_solution, run_breaks
 from .errors import AttitudeInputError
 from .params import AMBIGUITY_DEFAULTS, merge
 from .reading import FileData, read
@@ -33,7 +34,7 @@ def body_baselines(lever_arm: np.ndarray) -> np.ndarray:
 def _wrong(grp: FloatGroup, res: Resolution, fd: FileData) -> np.ndarray:
     """True where an accepted (full or partial) fix differs from the file's true DD ambiguities."""
     g, _, a, s = fd.ambiguity.shape
-    D = dd_operator(grp.signal, grp.sat, grp.ref, a, s, g)
+    D = dd_matrix(grp.signal, grp.sat, grp.ref, a, s, g)
     truth = fd.ambiguity[:, grp.epochs].transpose(1, 0, 2, 3).reshape(len(grp.epochs), -1) @ D.T
     out = np.zeros(len(grp.epochs), bool)
     for i, (zc, Z) in enumerate(zip(res.z_check, res.Z)):

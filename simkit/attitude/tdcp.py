@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import C_LIGHT, sagnac_rotate
+from ..constellation.geometry import sagnac_rotate
+from ..earth import C_LIGHT
 
 
 def _lsq(H, z, w):

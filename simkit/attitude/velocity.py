@@ -12,7 +12,7 @@ import json
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..frames import ecef_to_enu_matrix, ecef_to_lla
+from ..frames import ecef_to_enu_matrix, ecef_to_lla, euler_jacobian
 from ..gnss.atmosphere import troposphere
 from ..solution import Solution, warn_truth
 from .errors import AttitudeInputError
@@ -21,7 +21,6 @@ from .params import TDCP_DEFAULTS, merge
 from .reading import read
 from .solvers import solver
 from .tdcp import tdcp_velocity
-from .wahba import euler_jacobian
 
 _READ = {"pll_bandwidth_hz": 15.0, "dll_bandwidth_hz": 1.0, "correlator_spacing_chips": 0.5,
          "integration_time_s": 0.02, "carrier_multipath_m": 0.0, "code_multipath_m": 0.0,
@@ -42,7 +41,7 @@ def _attitudes(ds, fd, p, source):
     P = np.full((m, 3, 3), np.nan)
     if ok.any():
         R[ok] = Rotation.from_quat(sol.quat_nb[ok]).as_matrix()
-        Ji = np.linalg.inv(euler_jacobian(R[ok]))
+        Ji = np.linalg.inv(euler_jacobian(Rotation.from_matrix(R[ok])))
         P[ok] = Ji @ sol.cov[ok] @ np.swapaxes(Ji, 1, 2)
     return R, P
 

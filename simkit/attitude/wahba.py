@@ -10,15 +10,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..frames import euler_from_attitude
+from ..frames import euler_jacobian, skew
 from ..validation import atdop as validation_atdop
-
-
-def skew(v: np.ndarray) -> np.ndarray:
-    """[v x] (..., 3, 3) of vectors (..., 3)."""
-    z = np.zeros(v.shape[:-1])
-    x, y, w = v[..., 0], v[..., 1], v[..., 2]
-    return np.stack([np.stack([z, -w, y], -1), np.stack([w, z, -x], -1), np.stack([-y, x, z], -1)], -2)
 
 
 def _proper(U, Vt):
@@ -57,24 +50,9 @@ def phi_covariance(R: np.ndarray, F: np.ndarray, Qb: np.ndarray) -> np.ndarray:
     return np.linalg.inv(N)
 
 
-def euler_jacobian(R: np.ndarray, eps: float = 1e-6) -> np.ndarray:
-    """J (K, 3, 3) = d [pitch, roll, heading] / d phi (ENU small rotation), by central differences."""
-    J = np.empty(R.shape)
-    rot = Rotation.from_matrix(R)
-    for i in range(3):
-        step = np.zeros(3)
-        step[i] = eps
-        hi = euler_from_attitude(Rotation.from_rotvec(step) * rot)
-        lo = euler_from_attitude(Rotation.from_rotvec(-step) * rot)
-        d = hi - lo
-        d[:, 2] = np.mod(d[:, 2] + np.pi, 2 * np.pi) - np.pi
-        J[:, :, i] = d / (2 * eps)
-    return J
-
-
 def euler_covariance(R: np.ndarray, P_phi: np.ndarray) -> np.ndarray:
     """Covariance (K, 3, 3) rad^2 of [pitch, roll, heading] from the ENU attitude-error covariance."""
-    J = euler_jacobian(R)
+    J = euler_jacobian(Rotation.from_matrix(R))
     return J @ P_phi @ np.swapaxes(J, 1, 2)
 
 
@@ -110,7 +88,7 @@ def euler_atdop(R: np.ndarray, F: np.ndarray, G: np.ndarray, Q: np.ndarray | Non
     else:
         s2 = np.mean(np.diagonal(Q, axis1=1, axis2=2), axis=1)[:, None, None]
         L = np.swapaxes(H, 1, 2) @ np.linalg.solve(Q / s2, H)
-    Ji = np.linalg.inv(euler_jacobian(R))
+    Ji = np.linalg.inv(euler_jacobian(Rotation.from_matrix(R)))
     return validation_atdop(np.swapaxes(Ji, 1, 2) @ L @ Ji)
 
 

@@ -14,10 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import earth, frames
-from ..earth import C_LIGHT, OMEGA_E
+from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from .geometry import angles_from_enu
 
-_OMEGA = np.array([0.0, 0.0, OMEGA_E])
 
 
 @dataclass(frozen=True)
@@ -48,13 +47,13 @@ def antenna_view(ref: dict, ant_pos: np.ndarray, ant_vel: np.ndarray) -> Antenna
     ``sat_drift`` as (M, S[, 3]), see :meth:`simkit.constellation.Sky.view`) to antennas at ``ant_pos`` (M, A, 3)
     m moving at ``ant_vel`` (M, A, 3) m/s, both ECEF."""
     x0 = ref["sat_pos"][:, None]                                   # (M, 1, S, 3), ECEF frame at reception
-    v_in = ref["sat_vel"][:, None] + np.cross(_OMEGA, x0)          # inertial velocity in that frame
+    v_in = ref["sat_vel"][:, None] + np.cross(EARTH_RATE_ECEF, x0)          # inertial velocity in that frame
     r = ant_pos[:, :, None, :]
     d = _extra_light_time(x0, v_in, ref["tau"][:, None], r)
     diff = x0 - v_in * d[..., None] - r
     rng = np.linalg.norm(diff, axis=-1)
     u = diff / rng[..., None]
-    v_r = ant_vel[:, :, None, :] + np.cross(_OMEGA, r)
+    v_r = ant_vel[:, :, None, :] + np.cross(EARTH_RATE_ECEF, r)
     rr = np.einsum("masi,masi->mas", u, v_in - v_r) / (1.0 + np.einsum("masi,masi->mas", u, v_in) / C_LIGHT)
     el, az, el_rate, az_rate, lla, vel_enu = _angles(u, rng, ref["sat_vel"][:, None] - ant_vel[:, :, None, :],
                                                      ant_pos, ant_vel)

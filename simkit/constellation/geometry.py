@@ -56,6 +56,14 @@ def _rotate_z(vec, angle):
     return out
 
 
+def sagnac_rotate(sat_pos: np.ndarray, receiver: np.ndarray) -> np.ndarray:
+    """Satellite positions (M, S, 3) m ECEF of the emission epoch rotated about z by Omega_e * tau into the ECEF
+    frame of reception, tau = |sat_pos - receiver| / c the travel time to ``receiver`` (M, 3) m ECEF (one step:
+    the rotation moves a satellite by ~130 m, which changes tau by < 0.5 us and the angle by < 4e-11 rad)."""
+    tau = np.linalg.norm(sat_pos - receiver[:, None, :], axis=-1) / C_LIGHT
+    return _rotate_z(sat_pos, OMEGA_E * tau)
+
+
 def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: bool = False) -> Geometry:
     """Emission times by light-time iteration with Earth rotation, for receivers at ``rx_pos`` (M, 3) m ECEF at
     reception times (``gps_week`` scalar or (M,), ``gps_sow`` (M,) s GPS). Returns a :class:`Geometry`."""
@@ -97,9 +105,24 @@ def _light_time(const, rx, week_ms, sow):
 def elevation_azimuth(rx_pos, los):
     """Elevation and azimuth (rad) of unit line-of-sight vectors ``los`` (M, S, 3) ECEF seen from receivers at
     ``rx_pos`` (M, 3) m ECEF (geodetic vertical, WGS-84). Azimuth clockwise from north in [0, 2 pi)."""
+    return angles_from_enu(_to_enu(rx_pos, los))
+
+
+def _to_enu(rx_pos, vec):
+    """ECEF vectors ``vec`` (M, S, 3) in the local ENU frames (geodetic, WGS-84) of receivers ``rx_pos`` (M, 3) m."""
     lla = frames.ecef_to_lla(np.atleast_2d(rx_pos))
     c = frames.ecef_to_enu_matrix(lla[:, 0], lla[:, 1])  # (M, 3, 3)
-    return angles_from_enu(np.einsum("mij,msj->msi", c, los))
+    return np.einsum("mij,msj->msi", c, vec)
+
+
+def lines_of_sight_enu(rx_pos, sat_pos):
+    """Unit lines of sight receiver -> satellite (M, S, 3) in each receiver's ENU frame and their elevations (M, S)
+    rad, from receivers ``rx_pos`` (M, 3) m and satellites ``sat_pos`` (M, S, 3) m, both in one ECEF frame (NaN
+    where a satellite has no position or coincides with the receiver)."""
+    d = np.asarray(sat_pos, dtype=float) - np.asarray(rx_pos, dtype=float)[:, None, :]
+    with np.errstate(invalid="ignore"):
+        e = _to_enu(rx_pos, d / np.linalg.norm(d, axis=-1, keepdims=True))
+    return e, angles_from_enu(e)[0]
 
 
 def angles_from_enu(enu):

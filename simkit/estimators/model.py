@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from ..earth import OMEGA_E
+from .. import frames
 from . import nav
 
 
@@ -104,9 +105,7 @@ def euler(c):
     return np.array([pitch, roll, heading])
 
 
-@njit(cache=True)
-def wrap(a):
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
+wrap = njit(cache=True)(frames.wrap)  # the compiled form of the one definition, for the filter kernels
 
 
 @njit(cache=True)

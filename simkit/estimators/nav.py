@@ -21,7 +21,8 @@ from ..earth import A, E2, F, GAMMA_E, K_SOMIGLIANA, M_RATIO, OMEGA_E
 
 @njit(cache=True)
 def skew(v):
-    """[v x] (3, 3)."""
+    """[v x] (3, 3) of one vector v (3,): the compiled form of :func:`simkit.frames.skew` that the filter kernels
+    call (numba compiles neither that one's stacking over leading axes nor a call back into numpy code)."""
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 

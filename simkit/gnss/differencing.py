@@ -81,23 +81,27 @@ def dd_operator(ref_sat: np.ndarray, valid: np.ndarray, n_antennas: int, ref_ant
     with DD = D @ x.reshape(-1) for x (A, S), and the antenna and satellite index of each of the K rows (rows
     ordered by antenna, then satellite).
     """
+    ref_sat = np.asarray(ref_sat)
     s_count = ref_sat.shape[0]
-    sats = [s for s in range(s_count) if valid[s] and ref_sat[s] >= 0 and ref_sat[s] != s]
-    others = [a for a in range(n_antennas) if a != ref_antenna]
-    d = np.zeros((len(others) * len(sats), n_antennas * s_count))
-    ant_idx, sat_idx = [], []
-    row = 0
-    for a in others:
-        for s in sats:
-            r = ref_sat[s]
-            d[row, a * s_count + s] += 1.0
-            d[row, ref_antenna * s_count + s] -= 1.0
-            d[row, a * s_count + r] -= 1.0
-            d[row, ref_antenna * s_count + r] += 1.0
-            ant_idx.append(a)
-            sat_idx.append(s)
-            row += 1
-    return d, np.array(ant_idx, dtype=np.int64), np.array(sat_idx, dtype=np.int64)
+    sats = np.flatnonzero(np.asarray(valid, dtype=bool) & (ref_sat >= 0) & (ref_sat != np.arange(s_count)))
+    others = np.array([a for a in range(n_antennas) if a != ref_antenna], dtype=np.int64)
+    d = dd_matrix(np.zeros(len(sats), dtype=np.int64), sats, ref_sat[sats], n_antennas, s_count, 1, ref_antenna)
+    return d, np.repeat(others, len(sats)), np.tile(sats.astype(np.int64), len(others))
+
+
+def dd_matrix(signal, sat, ref, n_ant: int, n_sat: int, n_sig: int = 1, ref_antenna: int = 0) -> np.ndarray:
+    """D (r n, G A S) with DD = D x for x (G, A, S) flattened, for n channels (``signal``, ``sat``, ``ref`` (n,)
+    int: signal, satellite and its reference satellite) on the r = A - 1 baselines from ``ref_antenna``; rows
+    baseline-major (antennas in order, the reference left out), then channel."""
+    n = len(sat)
+    others = [a for a in range(n_ant) if a != ref_antenna]
+    D = np.zeros((len(others), n, n_sig, n_ant, n_sat))
+    c = np.arange(n)
+    for k, ant in enumerate(others):
+        for a, sign in ((ant, 1.0), (ref_antenna, -1.0)):
+            np.add.at(D[k], (c, signal, a, sat), sign)
+            np.add.at(D[k], (c, signal, a, ref), -sign)
+    return D.reshape(len(others) * n, n_sig * n_ant * n_sat)
 
 
 def dd_covariance(sigma: np.ndarray, ref_sat: np.ndarray, valid: np.ndarray, ref_antenna: int = 0):

@@ -19,11 +19,10 @@ split.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .. import frames, gpstime, rng
 from ..constellation import Sky, antenna_view
-from ..earth import C_LIGHT, OMEGA_E
+from ..earth import C_LIGHT
 from . import atmosphere, noise, signals as sigmod
 from .clock import ClockProcess
 from .config import GnssConfig, check_sats
@@ -32,7 +31,6 @@ from .multipath import elevation_scale, multipath_bank
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
 
-_OMEGA = np.array([0.0, 0.0, OMEGA_E])
 _GD_NAMES = {"tgd": ("TGD",), "tgd1": ("TGD1",), "tgd2": ("TGD2",)}
 _GD_PREFERRED = {"B1C": ("TGD_B1Cp",), "B2a": ("TGD_B2ap",)}
 _MASK_MARGIN_RAD = 1e-3  # satellites this close below the mask at the IMU centre may be up at an antenna
@@ -122,8 +120,8 @@ class GnssSimulator:
         t = np.asarray(t, dtype=float)
         pos = np.asarray(pos_ecef, dtype=float).reshape(t.size, 3)
         week, sow = gpstime.add_seconds(self.start_week, self.start_sow, t)
-        ant_pos, ant_vel, c_be = self._antennas(pos, np.asarray(vel_ecef, dtype=float).reshape(t.size, 3),
-                                                quat_nb, omega_ib_b)
+        ant_pos, ant_vel, c_be = frames.lever_arm_ecef(pos, np.asarray(vel_ecef, dtype=float).reshape(t.size, 3),
+                                                       quat_nb, omega_ib_b, self.lever)
         ref = self.sky.view(pos, week, sow)
         with np.errstate(invalid="ignore"):
             cand = np.flatnonzero((ref["elevation"] >= self.cfg.elevation_mask_rad - _MASK_MARGIN_RAD).any(axis=0))
@@ -136,17 +134,6 @@ class GnssSimulator:
                           truth=parts.truth(ant_pos, ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
 
     # ------------------------------------------------------------------ steps
-    def _antennas(self, pos, vel, quat_nb, omega_ib_b):
-        """Antenna phase-centre positions and velocities (M, A, 3) ECEF, and C_b^e (M, 3, 3)."""
-        lla = frames.ecef_to_lla(pos)
-        c_en = frames.ecef_to_enu_matrix(lla[:, 0], lla[:, 1])              # C_e^n (M, 3, 3)
-        c_nb = Rotation.from_quat(np.asarray(quat_nb, dtype=float).reshape(-1, 4)).as_matrix()
-        c_be = np.einsum("mji,mjk->mik", c_en, c_nb)                        # C_b^e = (C_e^n)^T C_b^n
-        w_eb = np.asarray(omega_ib_b, dtype=float).reshape(-1, 3) - np.einsum("mji,j->mi", c_be, _OMEGA)
-        ant_pos = pos[:, None, :] + np.einsum("mij,aj->mai", c_be, self.lever)
-        ant_vel = vel[:, None, :] + np.einsum("mij,maj->mai", c_be, np.cross(w_eb[:, None, :], self.lever[None]))
-        return ant_pos, ant_vel, c_be
-
     def _visibility(self, t, view, c_be, cand):
         """Visible (M, A, C): above the elevation mask and the antenna's body-frame horizon, outside scheduled
         outages; and the off-boresight angle (M, A, C) rad."""

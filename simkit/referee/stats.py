@@ -24,7 +24,6 @@ from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
 from .. import frames
-from . import quat
 from .compare import STATE_SERIES, Errors
 
 STATS = ("rms", "mean", "std", "max", "p50", "p95", "p99")
@@ -138,22 +137,10 @@ def sigma_bands(err: Errors, cov: np.ndarray, state_names) -> dict[str, np.ndarr
         idx = [j for j, _ in att_cols]
         S = np.diag([1.0 / f for _, f in att_cols])          # att = S state (f = +-1)
         P_att = S @ P[:, idx][:, :, idx] @ S
-        G = euler_jacobian(err.quat_nb)
+        G = frames.euler_jacobian(Rotation.from_quat(err.quat_nb))
         out["euler"] = np.sqrt(np.einsum("kij,kjl,kil->ki", G, P_att, G))
     del out["att_enu"]
     return out
-
-
-def euler_jacobian(quat_nb: np.ndarray, step: float = 1e-6) -> np.ndarray:
-    """(K, 3, 3) derivative of Euler [pitch, roll, heading] (rad) with respect to a misalignment phi (ENU, rad),
-    C = exp([phi x]) C_nb, at the attitudes ``quat_nb`` (K, 4), by central differences of ``step`` rad."""
-    cols = []
-    for axis in np.eye(3):
-        plus = quat.mul(quat.from_rotvec(step * axis), quat_nb)
-        minus = quat.mul(quat.from_rotvec(-step * axis), quat_nb)
-        d = frames.euler_from_attitude(Rotation.from_quat(plus)) - frames.euler_from_attitude(Rotation.from_quat(minus))
-        cols.append((np.mod(d + np.pi, 2 * np.pi) - np.pi) / (2 * step))
-    return np.stack(cols, axis=-1)
 
 
 def chi_square(value: np.ndarray, dof: np.ndarray, confidence: float = 0.95) -> dict:

@@ -15,9 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scipy.spatial.transform import Rotation
 
-from .. import earth, frames
+from .. import frames
 from ..io import open_dataset
 from ..solution import parse_point
 from . import quat
@@ -114,12 +113,11 @@ def at_point(ref: Truth, lever_b: np.ndarray | None, where: str = "estimate") ->
         return ref
     if ref.omega_ib_b is None:
         raise RefereeInputError(where, "scoring a point off the IMU centre needs /truth/omega_ib_b in the truth file")
-    c_nb = Rotation.from_quat(ref.quat_nb).as_matrix()                     # C_b^n (K, 3, 3)
     lla = frames.ecef_to_lla(ref.pos_ecef)
-    w_ie_b = np.einsum("kji,kj->ki", c_nb, earth.earth_rate_enu(lla[:, 0]))  # C_n^b w_ie^n
-    pos = ref.pos_ecef + frames.enu_to_ecef_vec(c_nb @ lever_b, lla[:, 0], lla[:, 1])
-    vel_n = ref.vel_enu + np.einsum("kij,kj->ki", c_nb, np.cross(ref.omega_ib_b - w_ie_b, lever_b))
+    pos, vel_e, _ = frames.lever_arm_ecef(ref.pos_ecef, frames.enu_to_ecef_vec(ref.vel_enu, lla[:, 0], lla[:, 1]),
+                                          ref.quat_nb, ref.omega_ib_b, np.asarray(lever_b, dtype=float)[None])
+    pos, vel_e = pos[:, 0], vel_e[:, 0]
     # ENU at the point itself: the two local frames differ by |l| / R (3e-7 rad for 2 m, 0.1 mm/s at 300 m/s)
     lla_point = frames.ecef_to_lla(pos)
-    vel = frames.ecef_to_enu_vec(frames.enu_to_ecef_vec(vel_n, lla[:, 0], lla[:, 1]), lla_point[:, 0], lla_point[:, 1])
+    vel = frames.ecef_to_enu_vec(vel_e, lla_point[:, 0], lla_point[:, 1])
     return Truth(ref.t, pos, vel, ref.quat_nb, ref.omega_ib_b, ref.lever_arm_b)

@@ -11,7 +11,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from .. import frames, gpstime
+from .. import gpstime
+from ..constellation.geometry import lines_of_sight_enu
 from .errors import ValidationInputError
 
 
@@ -46,14 +47,8 @@ class ValidationGeometry:
 def body_los(sat_pos_ecef, rx_pos_ecef, quat_nb) -> tuple[np.ndarray, np.ndarray]:
     """Unit lines of sight (M, S, 3) in the body frame and elevations (M, S) rad, from satellites ``sat_pos_ecef``
     (M, S, 3) m, receiver ``rx_pos_ecef`` (M, 3) m and attitude ``quat_nb`` (M, 4) body -> ENU, scalar last."""
-    d = np.asarray(sat_pos_ecef, float) - np.asarray(rx_pos_ecef, float)[:, None, :]
-    with np.errstate(invalid="ignore"):
-        u = d / np.linalg.norm(d, axis=-1, keepdims=True)
-    lla = frames.ecef_to_lla(rx_pos_ecef)
-    C = frames.ecef_to_enu_matrix(lla[:, 0], lla[:, 1])            # (M, 3, 3) C_e^n
+    u_enu, el = lines_of_sight_enu(rx_pos_ecef, sat_pos_ecef)
     C_bn = Rotation.from_quat(quat_nb).inv().as_matrix()           # (M, 3, 3) C_n^b
-    u_enu = np.einsum("mij,msj->msi", C, u)
-    el = np.arcsin(np.clip(u_enu[..., 2], -1.0, 1.0))
     return np.einsum("mij,msj->msi", C_bn, u_enu), el
 
 

@@ -21,17 +21,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..frames import skew
 from .errors import ValidationInputError
 
 WEIGHTINGS = ("dd", "identity")
-
-
-def skew(v) -> np.ndarray:
-    """[v x] (..., 3, 3) of vectors ``v`` (..., 3): skew(v) @ x == cross(v, x)."""
-    v = np.asarray(v, dtype=float)
-    z = np.zeros(v.shape[:-1])
-    x, y, w = v[..., 0], v[..., 1], v[..., 2]
-    return np.stack([np.stack([z, -w, y], -1), np.stack([w, z, -x], -1), np.stack([-y, x, z], -1)], -2)
 
 
 def _check_baselines(baselines_b) -> np.ndarray:
