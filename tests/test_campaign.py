@@ -217,3 +217,11 @@ def test_worker_tuning_undoes_the_page_faults_of_dasks_malloc_setting():
     untuned, tuned = map(float, out.stdout.split())
     assert untuned > 200
     assert tuned < 20
+
+
+def test_the_mean_interval_of_identical_values_is_the_value_itself():
+    """Regression: scipy's Student-t interval is NaN for a zero scale, and the campaign summary (JSON without NaN)
+    failed on a metric that every run gave the same value."""
+    from simkit.campaign.stats import mean_interval
+
+    assert mean_interval([2.5, 2.5, 2.5])["ci"] == [2.5, 2.5]

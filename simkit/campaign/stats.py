@@ -43,7 +43,8 @@ def mean_interval(values, confidence: float = 0.95) -> dict:
     out = {"n": int(x.size), "mean": mean, "std": None, "min": float(x.min()), "max": float(x.max()), "ci": None}
     if x.size >= 2:
         std = float(x.std(ddof=1))
-        lo, hi = student_t.interval(confidence, x.size - 1, loc=mean, scale=sem(x))
+        scale = sem(x)  # scipy's interval is NaN for scale 0: identical values give the degenerate [mean, mean]
+        lo, hi = student_t.interval(confidence, x.size - 1, loc=mean, scale=scale) if scale > 0 else (mean, mean)
         out.update(std=std, ci=[float(lo), float(hi)])
     return out
 
