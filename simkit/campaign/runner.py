@@ -47,9 +47,11 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         with client:
             yield client
         return
+    # CRITICAL: a run's failure reaches the campaign through its future (and its triage), while Dask's own ERROR
+    # lines are the local cluster's teardown noise (a worker's heartbeat to a scheduler closed by Ctrl-C)
     with _sigint_ignored():
         cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                               scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
+                               scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
     with cluster, Client(cluster) as client:
         yield client
 
