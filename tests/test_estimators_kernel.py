@@ -1,4 +1,4 @@
-"""The filter kernel's interface: named tuples (simkit.estimators.loop.Imu, Nav, Tuning, Fixes, DDRows, Outputs)
+"""The filter kernel's interface: named tuples (simkit.estimators.loop.Samples, Nav, Tuning, Fixes, DDRows, Outputs)
 instead of long positional argument lists and tuples read by index."""
 import ast
 from pathlib import Path

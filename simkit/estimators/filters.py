@@ -129,8 +129,8 @@ def _spans(starts, lengths):
 def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0, first: int = 1):
     """The loop's :class:`.loop.DDRows` (epochs at an IMU sample, one per sample, first kept)."""
     if dd is None:
-        return loop.DDRows(np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
-                np.zeros(1, np.int64), np.zeros(0), np.zeros(0))
+        return loop.DDRows(np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
+                           np.zeros(0), np.zeros(1, np.int64), np.zeros(0), np.zeros(0))
     k = sample_index(t_imu, dd.t, first)
     good = (k >= 0) & np.concatenate([[True], np.diff(k) > 0])
     idx = np.flatnonzero(good)
@@ -139,9 +139,9 @@ def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0, first: int = 1)
     crow = _spans(np.concatenate([[0], np.cumsum(m**2)])[idx], m[idx] ** 2)
     gate = chi2.isf(gate_p, m[idx]) if gate_p > 0 else np.full(idx.size, np.inf)
     return loop.DDRows(k[idx].astype(np.int64), np.concatenate([[0], np.cumsum(m[idx])]).astype(np.int64),
-                       dd.los_enu[rows],
-            dd.baseline_b[rows], dd.range_m[rows], np.concatenate([[0], np.cumsum(m[idx] ** 2)]).astype(np.int64),
-            dd.cov[crow], np.asarray(gate, float))
+                       dd.los_enu[rows], dd.baseline_b[rows], dd.range_m[rows],
+                       np.concatenate([[0], np.cumsum(m[idx] ** 2)]).astype(np.int64), dd.cov[crow],
+                       np.asarray(gate, float))
 
 
 class _LooselyCoupled:
@@ -182,7 +182,7 @@ class _LooselyCoupled:
         w_mean = window_mean_rate(comp, int(round(cfg.lever_rate_window_s / float(np.median(comp.dt)))))
         tuning = loop.Tuning(_p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), self._mode(),
                              float(cfg.alpha))
-        loop.run(loop.Imu(comp.phi, comp.dvb, comp.dt, comp.w_ib, w_mean), nav0, tuning, garr, aarr, darr, out)
+        loop.run(loop.Samples(comp.phi, comp.dvb, comp.dt, comp.w_ib, w_mean), nav0, tuning, garr, aarr, darr, out)
         sol = self._solution(imu.t[garr.k], out)
         return _with_dd(sol, garr.k, darr, out.dd_nis) if self.uses_dd else sol
 

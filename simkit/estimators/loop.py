@@ -25,7 +25,7 @@ class Nav(NamedTuple):
     lever: np.ndarray
 
 
-class Imu(NamedTuple):
+class Samples(NamedTuple):
     """The compensated IMU (:class:`.increments.Compensated`): ``phi`` (N, 3) rad, ``dvb`` (N, 3) m/s increments
     over ``dt`` (N,) s; ``w_ib`` (N + 1, 3) rad/s body rate at each sample, ``w_mean`` its trailing window mean."""
 
@@ -163,7 +163,7 @@ def allocate(m, n, k_att, k_dd) -> Outputs:
 
 @njit(cache=True)
 def run(imu, nav0, tuning, gnss, att, dd, out):
-    """The recursion over the compensated IMU ``imu`` (:class:`Imu`; a fix at sample s predicts its lever velocity
+    """The recursion over the compensated IMU ``imu`` (:class:`Samples`; a fix at sample s predicts its lever velocity
     with w_ib[s], H's lever rows use the trailing mean w_mean: :func:`_pv_rows`) from ``nav0`` (:class:`Nav`)
     with ``tuning`` (:class:`Tuning`), position/velocity fixes ``gnss`` and attitude fixes ``att``
     (:class:`Fixes`) and the fixed DD carrier ``dd`` (:class:`DDRows`). Fills ``out`` (:class:`Outputs`)."""

@@ -1,4 +1,5 @@
-"""The dispatch of ``simkit solve``: ``SOLVERS[name](ds, params, progress) -> Solution`` for spp, kf15, kf15_dd, kf21, hinf.
+"""The dispatch of ``simkit solve``: ``SOLVERS[name](ds, params, progress) -> Solution`` for spp, kf15, kf15_dd,
+kf21, hinf; the file is read by :mod:`.adapter`, the alignment chosen by :mod:`.align_policy`.
 
 ``params`` are ``--set estimator.key=value`` overrides over ``DEFAULTS`` (an unknown key is an error naming it).
 Noise defaults come from the file's ``/imu`` model attributes (white noise, turn-on bias, rate random walk), so
