@@ -1,7 +1,6 @@
 """Default ambiguity validation of the attitude solvers on a simulated airborne file: single-epoch resolution at
 forced satellite counts must not accept more wrong fixes than the tolerated failure rate pf allows
 (docs/attitude.md, "Validation at low satellite counts"), and the solutions record the signals they used."""
-import numpy as np
 import pytest
 
 import simkit

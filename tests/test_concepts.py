@@ -4,7 +4,6 @@ import ast
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from simkit import frames
 from simkit.estimators import model, nav

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..gnss import signals as gsig
 from ..gnss.noise import dll_sigma_m, pll_sigma_m
+from ..io import gnss_signals, has, path_of, read_gnss
 from .dd import Observations
 from .errors import AttitudeInputError
 from .geometry import code_position, lines_of_sight
@@ -33,7 +34,7 @@ class FileData:
 
 
 def _signals(ds, wanted: str) -> tuple:
-    have = tuple(str(s) for s in ds["gnss/signals"][:])
+    have = gnss_signals(ds)
     if wanted == "all":
         return have
     names = tuple(s.strip() for s in wanted.split(",") if s.strip())
@@ -53,12 +54,16 @@ def _variances(cn0, el, wavelength, chip, p):
     return vc + vm, vp + (p["code_multipath_m"] * mp) ** 2, vm + 0.0 * vc
 
 
+NEEDED = (("gnss", "t"), ("obs", None), ("antennas", "lever_arm_b"), ("gnss", "sat_pos_ecef"))
+
+
 def read(ds, p: dict) -> FileData:
     """Read the GNSS part of ``ds`` for the parameters ``p`` (signals, start_s, stop_s, noise model)."""
-    for key in ("gnss/t", "gnss/obs", "gnss/antennas/lever_arm_b", "gnss/sat_pos_ecef"):
-        if key not in ds:
-            raise AttitudeInputError(key, "missing from the file; expected a simkit file with GNSS observations")
-    t_all = ds["gnss/t"][:]
+    for group, name in NEEDED:
+        if not has(ds, group, name):
+            raise AttitudeInputError(path_of(group, name),
+                                     "missing from the file; expected a simkit file with GNSS observations")
+    t_all = read_gnss(ds, satellites=False).t
     sel = np.flatnonzero((t_all >= p["start_s"]) & (t_all <= p["stop_s"]))
     if sel.size == 0:
         raise AttitudeInputError("estimator.start_s", f"no GNSS epoch in [{p['start_s']}, {p['stop_s']}] s")
@@ -66,20 +71,19 @@ def read(ds, p: dict) -> FileData:
         raise AttitudeInputError("estimator.every", f"{p['every']}; expected an integer >= 1")
     sl = slice(sel[0], sel[-1] + 1, p["every"])
     names = _signals(ds, p["signals"])
-    sat_pos, sat_clock = ds["gnss/sat_pos_ecef"][sl], ds["gnss/sat_clock"][sl]
-    code = np.stack([ds[f"gnss/obs/{g}/code"][sl] for g in names])
+    g = read_gnss(ds, signals=names, epochs=sl, obs=("code", "carrier", "cn0", "ambiguity", "lli"))
+    code = np.stack([g.obs["code"][s] for s in names])
     with warnings.catch_warnings():  # a satellite no signal tracks: its mean is NaN, as wanted
         warnings.simplefilter("ignore", RuntimeWarning)
-        receiver = code_position(np.nanmean(code[:, :, 0], axis=0), sat_pos, sat_clock)
-    los, el = lines_of_sight(receiver, sat_pos)
-    sigs = [gsig.get(g) for g in names]
+        receiver = code_position(np.nanmean(code[:, :, 0], axis=0), g.sat_pos_ecef, g.sat_clock)
+    los, el = lines_of_sight(receiver, g.sat_pos_ecef)
+    sigs = [gsig.get(s) for s in names]
     lam = np.array([s.wavelength_m for s in sigs])
-    var = [_variances(ds[f"gnss/obs/{g}/cn0"][sl], el[:, None, :], s.wavelength_m, s.chip_length_m, p)
-           for g, s in zip(names, sigs)]
-    obs = Observations(np.stack([ds[f"gnss/obs/{g}/carrier"][sl] for g in names]), code,
+    var = [_variances(g.obs["cn0"][n], el[:, None, :], s.wavelength_m, s.chip_length_m, p)
+           for n, s in zip(names, sigs)]
+    obs = Observations(np.stack([g.obs["carrier"][s] for s in names]), code,
                        np.stack([v[0] for v in var]), np.stack([v[1] for v in var]), lam, los, el,
-                       ds["gnss/sat_id"][:], np.stack([v[2] for v in var]))
-    amb = np.stack([ds[f"gnss/obs/{g}/ambiguity"][sl] for g in names])
-    lli = np.stack([ds[f"gnss/obs/{g}/lli"][sl] for g in names])
-    return FileData(t_all[sl], obs, amb, lli, ds["gnss/antennas/lever_arm_b"][:], names, receiver, sat_pos,
-                    sat_clock)
+                       g.sat_id, np.stack([v[2] for v in var]))
+    amb = np.stack([g.obs["ambiguity"][s] for s in names])
+    lli = np.stack([g.obs["lli"][s] for s in names])
+    return FileData(g.t, obs, amb, lli, g.lever_arm_b, names, receiver, g.sat_pos_ecef, g.sat_clock)

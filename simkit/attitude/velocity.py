@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from ..frames import ecef_to_enu_matrix, ecef_to_lla, euler_jacobian
 from ..gnss.atmosphere import troposphere
+from ..io import has, path_of, read_imu, read_truth
 from ..solution import Solution, warn_truth
 from .errors import AttitudeInputError
 from .lever import lever_velocity_differenced, lever_velocity_rate, tdcp_velocity_covariance
@@ -31,9 +32,8 @@ def _attitudes(ds, fd, p, source):
     """(R (M, 3, 3) body -> ENU, NaN where none; P (M, 3, 3) ENU attitude-error covariance rad^2)."""
     m = len(fd.t)
     if source == "truth":
-        tt = ds["truth/t"][:]
-        k = np.clip(np.searchsorted(tt, fd.t - 1e-9), 0, len(tt) - 1)
-        return Rotation.from_quat(ds["truth/quat_nb"][:][k]).as_matrix(), np.zeros((m, 3, 3))
+        quat = read_truth(ds, t=fd.t, fields=("quat_nb",), required=("quat_nb",), tol_s=1e-9).quat_nb
+        return Rotation.from_quat(quat).as_matrix(), np.zeros((m, 3, 3))
     sol = solver("attitude")(ds, {"start_s": p["start_s"], "stop_s": p["stop_s"], "every": p["every"],
                                   "signals": p["signals"], "mask_deg": p["mask_deg"]}, False)
     ok = np.isin(sol.extras["status"], (1, 3)) & np.isfinite(sol.quat_nb).all(1)
@@ -48,13 +48,11 @@ def _attitudes(ds, fd, p, source):
 
 def _gyro_mean(ds, t0, t1):
     """Mean w_ib^b (K, 3) rad/s over (t0, t1] from /imu, and the rate error covariance (K, 3, 3)."""
-    t = ds["imu/t"][:]
-    if "imu/gyro" in ds:
-        inc = ds["imu/gyro"][:] * np.gradient(t)[:, None]
-    elif "imu/dtheta" in ds:
-        inc = ds["imu/dtheta"][:]
-    else:
-        raise AttitudeInputError("imu/gyro", "missing; estimator.lever_rate = 'imu' needs IMU data")
+    if not has(ds, "imu", "gyro") and not has(ds, "imu", "dtheta"):
+        raise AttitudeInputError(path_of("imu", "gyro"), "missing; estimator.lever_rate = 'imu' needs IMU data")
+    imu = read_imu(ds, fields=("gyro",) if has(ds, "imu", "gyro") else ("dtheta",))
+    t = imu.t
+    inc = imu.gyro * np.gradient(t)[:, None] if imu.gyro is not None else imu.dtheta
     c = np.concatenate([np.zeros((1, 3)), np.cumsum(inc, axis=0)])
     i0, i1 = np.searchsorted(t, t0 + 1e-9), np.searchsorted(t, t1 + 1e-9)
     dt = t1 - t0
@@ -111,7 +109,7 @@ def solve_tdcp(ds, params: dict | None = None, progress: bool = False) -> Soluti
     if not 0 <= ant < a:
         raise AttitudeInputError("estimator.antenna", f"{ant}; expected 0 .. {a - 1}")
     if m < 2:
-        raise AttitudeInputError("gnss/t", f"{m} epoch(s); TDCP needs at least 2")
+        raise AttitudeInputError(path_of("gnss", "t"), f"{m} epoch(s); TDCP needs at least 2")
     phase = (fd.obs.carrier[:, :, ant] * fd.obs.wavelength[:, None, None]).transpose(1, 0, 2).reshape(m, -1)
     up = fd.obs.elevation >= np.radians(p["mask_deg"])
     ok = np.isfinite(phase) & np.tile(up, (1, g))

@@ -18,6 +18,7 @@ import numpy as np
 from ..ambiguity import bootstrap_success_rate, ils_batch
 from ..gnss.differencing import double_difference, float_solution, reference_satellites, systems_of
 from ..gnss.signals import SIGNALS
+from ..io import gnss_signals, n_antennas, read_gnss
 from .registry import register
 
 MIN_SIGMA_PHASE_M = 1e-4   # floors for files simulated with noise switched off (a singular float model otherwise)
@@ -32,16 +33,18 @@ def _los_enu(az: np.ndarray, el: np.ndarray) -> np.ndarray:
 def dd_observations(ds, signal: str, pair=(0, 1)) -> dict:
     """DD carrier (M, S) cycles, code (M, S) m, true ambiguity (M, S), geometry G (M, S, 3) and the usable mask
     (M, S) of ``signal`` between antennas ``pair`` (master first) over the satellites of the signal's system."""
-    sat_ids = ds["gnss/sat_id"][()]
+    g = read_gnss(ds, signals=[signal], obs=("carrier", "code", "ambiguity"), truth=("elevation", "azimuth"),
+                  satellites=False)
+    sat_ids = g.sat_id
     cols = np.flatnonzero(systems_of(sat_ids) == SIGNALS[signal].system)
     ants = list(pair)
 
-    def read(path):
-        return ds[path][()][:, ants][:, :, cols]
+    def select(x):
+        return x[:, ants][:, :, cols]
 
-    carrier, code = read(f"gnss/obs/{signal}/carrier"), read(f"gnss/obs/{signal}/code")
-    amb = read(f"gnss/obs/{signal}/ambiguity").astype(float)
-    el, az = read("gnss/truth/elevation")[:, 0], read("gnss/truth/azimuth")[:, 0]
+    carrier, code = select(g.obs["carrier"][signal]), select(g.obs["code"][signal])
+    amb = select(g.obs["ambiguity"][signal]).astype(float)
+    el, az = select(g.truth["elevation"])[:, 0], select(g.truth["azimuth"])[:, 0]
     valid = np.isfinite(carrier).all(axis=1) & np.isfinite(code).all(axis=1)
     ref = reference_satellites(el, valid, sat_ids[cols])
     e = _los_enu(az, el)
@@ -54,7 +57,8 @@ def dd_observations(ds, signal: str, pair=(0, 1)) -> dict:
 
 
 def _sigma(ds, signal: str, name: str, floor: float) -> float:
-    s = ds[f"gnss/truth/{signal}/{name}"][()]
+    key = f"{signal}/{name}"
+    s = read_gnss(ds, signals=[signal], truth=(key,), satellites=False).truth[key]
     s = s[np.isfinite(s)]
     return max(float(np.median(s)) if s.size else 0.0, floor)
 
@@ -89,14 +93,14 @@ def ambiguity(ds, signal: str | None = None, pair=(0, 1), min_dd: int = 3) -> di
     """Single-epoch ILS success on ``signal`` (default: the file's first) between antennas ``pair``:
     ``ils_successes``, ``ils_trials`` (epochs with at least ``min_dd`` DDs), ``bootstrap_sr_mean`` (the model's
     bootstrapped success rate averaged over those epochs), ``epochs_skipped``, ``baseline_m`` (mean length)."""
-    if "gnss/signals" not in ds or ds["gnss/antennas/lever_arm_b"].shape[0] < 2:
+    if not gnss_signals(ds) or n_antennas(ds) < 2:
         return {}
-    signals = list(ds["gnss/signals"][()])
-    signal = signal or signals[0]
-    lam = float(ds["gnss/wavelength_m"][()][signals.index(signal)])
+    signal = signal or gnss_signals(ds)[0]
+    g = read_gnss(ds, signals=[signal], truth=("antenna_pos_ecef",), satellites=False)
+    lam = float(g.wavelength_m[0])
     r = single_epoch_ils(dd_observations(ds, signal, pair), lam, _sigma(ds, signal, "sigma_carrier",
                          MIN_SIGMA_PHASE_M), _sigma(ds, signal, "sigma_code", MIN_SIGMA_CODE_M), min_dd)
-    pos = ds["gnss/truth/antenna_pos_ecef"][()]
+    pos = g.truth["antenna_pos_ecef"]
     return {"ils_successes": r["successes"], "ils_trials": r["trials"],
             "bootstrap_sr_mean": r["bootstrap_sum"] / r["trials"] if r["trials"] else None,
             "epochs_skipped": r["skipped"],

@@ -107,16 +107,16 @@ def _gnss_arrays(gnss: GnssFixes, t_imu, first: int):
         tp = model.enu_to_geodetic(lla[i, 0], lla[i, 2])
         r[j, 0:3, 0:3] = tp @ gnss.pos_cov_enu[i] @ tp.T
         r[j, 3:6, 3:6] = gnss.vel_cov_enu[i]
-    return idx, (k[idx].astype(np.int64), z, r)
+    return idx, loop.Fixes(k[idx].astype(np.int64), z, r)
 
 
 def _att_arrays(att: AttitudeFixes | None, t_imu, first: int):
     if att is None:
-        return (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3, 3)))
+        return loop.Fixes(np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3, 3)))
     k = sample_index(t_imu, att.t, first)
     good = (k >= 0) & np.isfinite(att.euler).all(1)
     good &= np.concatenate([[True], np.diff(k) > 0])
-    return (k[good].astype(np.int64), att.euler[good], att.cov[good])
+    return loop.Fixes(k[good].astype(np.int64), att.euler[good], att.cov[good])
 
 
 def _spans(starts, lengths):
@@ -127,10 +127,10 @@ def _spans(starts, lengths):
 
 
 def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0, first: int = 1):
-    """The loop's DD tuple (epochs at an IMU sample, one per sample, first kept), row and covariance offsets."""
+    """The loop's :class:`.loop.DDRows` (epochs at an IMU sample, one per sample, first kept)."""
     if dd is None:
-        return (np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0),
-                np.zeros(1, np.int64), np.zeros(0), np.zeros(0))
+        return loop.DDRows(np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
+                           np.zeros(0), np.zeros(1, np.int64), np.zeros(0), np.zeros(0))
     k = sample_index(t_imu, dd.t, first)
     good = (k >= 0) & np.concatenate([[True], np.diff(k) > 0])
     idx = np.flatnonzero(good)
@@ -138,9 +138,10 @@ def _dd_arrays(dd: DDCarrier | None, t_imu, gate_p: float = 0.0, first: int = 1)
     rows = _spans(dd.offsets[idx], m[idx])
     crow = _spans(np.concatenate([[0], np.cumsum(m**2)])[idx], m[idx] ** 2)
     gate = chi2.isf(gate_p, m[idx]) if gate_p > 0 else np.full(idx.size, np.inf)
-    return (k[idx].astype(np.int64), np.concatenate([[0], np.cumsum(m[idx])]).astype(np.int64), dd.los_enu[rows],
-            dd.baseline_b[rows], dd.range_m[rows], np.concatenate([[0], np.cumsum(m[idx] ** 2)]).astype(np.int64),
-            dd.cov[crow], np.asarray(gate, float))
+    return loop.DDRows(k[idx].astype(np.int64), np.concatenate([[0], np.cumsum(m[idx])]).astype(np.int64),
+                       dd.los_enu[rows], dd.baseline_b[rows], dd.range_m[rows],
+                       np.concatenate([[0], np.cumsum(m[idx] ** 2)]).astype(np.int64), dd.cov[crow],
+                       np.asarray(gate, float))
 
 
 class _LooselyCoupled:
@@ -171,19 +172,19 @@ class _LooselyCoupled:
         comp = (from_increments if imu.increments else from_rates)(imu.t, imu.gyro, imu.accel)
         cfg, n = self.config, self.n_states
         pos0 = np.asarray(init.pos_lla, float)
-        nav0 = (Rotation.from_quat(init.quat_nb).as_matrix(), np.asarray(init.vel_enu, float), pos0,
-                np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy())
+        nav0 = loop.Nav(Rotation.from_quat(init.quat_nb).as_matrix(), np.asarray(init.vel_enu, float), pos0,
+                        np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy())
         first = 0 if cfg.update_at_start else 1  # sample 0 is the initial epoch
         idx, garr = _gnss_arrays(gnss, imu.t, first)
         aarr = _att_arrays(attitude if n > 15 else None, imu.t, first)
         darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p), first)
-        out = loop.allocate(idx.size, n)
-        att_nis, dd_nis = np.full(aarr[0].size, np.nan), np.full(darr[0].size, np.nan)
+        out = loop.allocate(idx.size, n, aarr.k.size, darr.k.size)
         w_mean = window_mean_rate(comp, int(round(cfg.lever_rate_window_s / float(np.median(comp.dt)))))
-        loop.run(comp.phi, comp.dvb, comp.dt, comp.w_ib, w_mean, nav0, _p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n),
-                 float(cfg.cov_dt), garr, aarr, darr, self._mode(), float(cfg.alpha), out, att_nis, dd_nis)
-        sol = self._solution(imu.t[garr[0]], out, att_nis)
-        return _with_dd(sol, garr[0], darr, dd_nis) if self.uses_dd else sol
+        tuning = loop.Tuning(_p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), self._mode(),
+                             float(cfg.alpha))
+        loop.run(loop.Samples(comp.phi, comp.dvb, comp.dt, comp.w_ib, w_mean), nav0, tuning, garr, aarr, darr, out)
+        sol = self._solution(imu.t[garr.k], out)
+        return _with_dd(sol, garr.k, darr, out.dd_nis) if self.uses_dd else sol
 
     def _mode(self) -> int:
         if self.mode == 0:
@@ -192,8 +193,8 @@ class _LooselyCoupled:
             raise EstimatorInputError(f"gamma_rule: expected 'wu' or 'weighted', got {self.config.gamma_rule!r}")
         return 1 if self.config.gamma_rule == "wu" else 2
 
-    def _solution(self, t, out, att_nis) -> Solution:
-        c, v, pos, cov, bias, lever, gamma, margin, nis, w, status = out
+    def _solution(self, t, out) -> Solution:
+        c, v, pos, cov, bias, lever, gamma, margin, nis, w, status, att_nis, _ = out
         rot = Rotation.from_matrix(c)
         extras = {"gyro_bias": bias[:, :3], "accel_bias": bias[:, 3:], "lever_arm": lever, "nis": nis,
                   "nis_dof": np.where(np.isfinite(nis), w.shape[1], 0).astype(np.int32),
@@ -247,18 +248,18 @@ class KalmanFilter15DD(_LooselyCoupled):
 def _with_dd(sol: Solution, g_k, darr, dd_nis) -> Solution:
     """Extras ``dd_rows`` (DD rows used at each output epoch's IMU sample, 0 where none) and ``dd_nis`` (NaN
     where none); config ``dd_epochs``, ``dd_rejected`` (by the gate), ``dd_nis_mean`` and ``dd_rows_mean``."""
-    dk, m = darr[0], np.diff(darr[1])
+    dk, m = darr.k, np.diff(darr.offsets)
     rows, nis = np.zeros(g_k.size, np.int32), np.full(g_k.size, np.nan)
     if dk.size:
         j = np.minimum(np.searchsorted(dk, g_k), dk.size - 1)
         hit = dk[j] == g_k
         jj = j[hit]
-        rows[hit], nis[hit] = np.where(dd_nis[jj] <= darr[7][jj], m[jj], 0), dd_nis[jj]
+        rows[hit], nis[hit] = np.where(dd_nis[jj] <= darr.gate[jj], m[jj], 0), dd_nis[jj]
     extras = {**sol.extras, "dd_rows": rows, "dd_nis": nis}
     units = {**sol.extra_units,
              "dd_rows": "1 (fixed DD carrier rows in the update at this epoch; 0: none or gated out)",
              "dd_nis": "1 (NIS of the DD carrier update at this epoch, chi-square with dd_rows dof)"}
-    config = {**sol.config, "dd_epochs": int(darr[0].size), "dd_rejected": int(np.sum(dd_nis > darr[7])),
+    config = {**sol.config, "dd_epochs": int(darr.k.size), "dd_rejected": int(np.sum(dd_nis > darr.gate)),
               "dd_nis_mean": float(np.nanmean(dd_nis)) if dd_nis.size else None,
               "dd_rows_mean": float(m.mean()) if m.size else 0.0}
     return Solution(**{**sol.__dict__, "extras": extras, "extra_units": units, "config": config})

@@ -5,10 +5,89 @@ epoch) are applied before the first step. ``mode`` 0 = Kalman, 1 = H-infinity wi
 gamma rule, 2 = H-infinity with the weighted gamma rule."""
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from . import kalman, model, nav
+
+
+class Nav(NamedTuple):
+    """The navigation state: ``c`` C_b^n (3, 3) body -> ENU, ``v`` (3,) m/s ENU, ``pos`` (3,) [lat rad, lon rad,
+    h m], ``bg`` (3,) rad/s gyro and ``ba`` (3,) m/s^2 accelerometer biases, ``lever`` (3,) m body frame."""
+
+    c: np.ndarray
+    v: np.ndarray
+    pos: np.ndarray
+    bg: np.ndarray
+    ba: np.ndarray
+    lever: np.ndarray
+
+
+class Samples(NamedTuple):
+    """The compensated IMU (:class:`.increments.Compensated`): ``phi`` (N, 3) rad, ``dvb`` (N, 3) m/s increments
+    over ``dt`` (N,) s; ``w_ib`` (N + 1, 3) rad/s body rate at each sample, ``w_mean`` its trailing window mean."""
+
+    phi: np.ndarray
+    dvb: np.ndarray
+    dt: np.ndarray
+    w_ib: np.ndarray
+    w_mean: np.ndarray
+
+
+class Tuning(NamedTuple):
+    """``p0`` (n, n) initial covariance, ``qc`` (n,) white-noise densities, ``cov_dt`` s covariance step, ``mode``
+    (0 Kalman, 1 H-infinity Wu's gamma, 2 weighted gamma), ``alpha`` the H-infinity alpha."""
+
+    p0: np.ndarray
+    qc: np.ndarray
+    cov_dt: float
+    mode: int
+    alpha: float
+
+
+class Fixes(NamedTuple):
+    """Measurements at IMU samples: ``k`` (M,) sample index, ``z`` (M, q) values, ``r`` (M, q, q) covariance.
+    Position/velocity fixes: z = [L rad, lambda rad, h m, vE, vN, vU m/s]; attitude: [pitch, roll, heading] rad."""
+
+    k: np.ndarray
+    z: np.ndarray
+    r: np.ndarray
+
+
+class DDRows(NamedTuple):
+    """Fixed DD carrier epochs: ``k`` (D,) sample index, ``offsets`` (D + 1,) row offsets, ``los`` (T, 3) ENU
+    unit vectors, ``baseline`` (T, 3) m body frame, ``range_m`` (T,) m DD ranges, ``cov_offsets`` (D + 1,),
+    ``cov`` the flattened covariance blocks m^2, ``gate`` (D,) NIS gate (inf: off)."""
+
+    k: np.ndarray
+    offsets: np.ndarray
+    los: np.ndarray
+    baseline: np.ndarray
+    range_m: np.ndarray
+    cov_offsets: np.ndarray
+    cov: np.ndarray
+    gate: np.ndarray
+
+
+class Outputs(NamedTuple):
+    """The recursion's outputs at the M fix epochs (``c`` .. ``status``, see :func:`allocate`) and the NIS of the
+    attitude (K,) and DD (D,) updates."""
+
+    c: np.ndarray
+    v: np.ndarray
+    pos: np.ndarray
+    cov: np.ndarray
+    bias: np.ndarray
+    lever: np.ndarray
+    gamma: np.ndarray
+    margin: np.ndarray
+    nis: np.ndarray
+    w: np.ndarray
+    status: np.ndarray
+    att_nis: np.ndarray
+    dd_nis: np.ndarray
 
 
 @njit(cache=True)
@@ -58,41 +137,42 @@ def _att_rows(c, z, n):
 
 @njit(cache=True)
 def _dd_rows(c, dd, i, n):
-    """Innovation, H and R of the fixed DD carrier rows of DD epoch ``i`` (see :func:`model.dd_rows`)."""
-    off, los, base, z, roff, cov = dd[1], dd[2], dd[3], dd[4], dd[5], dd[6]
-    a, b = off[i], off[i + 1]
+    """Innovation, H and R of the fixed DD carrier rows of DD epoch ``i`` of ``dd`` (:class:`DDRows`; see
+    :func:`model.dd_rows`)."""
+    a, b = dd.offsets[i], dd.offsets[i + 1]
     m = b - a
-    pred, h = model.dd_rows(c, los[a:b], base[a:b], n)
-    return pred - z[a:b], h, cov[roff[i]:roff[i + 1]].copy().reshape((m, m))
+    pred, h = model.dd_rows(c, dd.los[a:b], dd.baseline[a:b], n)
+    return pred - dd.range_m[a:b], h, dd.cov[dd.cov_offsets[i]:dd.cov_offsets[i + 1]].copy().reshape((m, m))
 
 
 @njit(cache=True)
-def _record(out, j, c, v, pos, p, bg, ba, lever, res):
-    o_c, o_v, o_p, o_cov, o_b, o_l, o_g, o_m, o_nis, o_w, o_s = out
-    o_c[j], o_v[j], o_p[j], o_cov[j] = c, v, pos, p
-    o_b[j, 0:3], o_b[j, 3:6], o_l[j] = bg, ba, lever
-    o_nis[j], o_w[j], o_g[j], o_m[j], o_s[j] = res[2], res[3], res[4], res[5], res[6]
+def _record(out, j, nav, p, res):
+    """Store the state ``nav`` (:class:`Nav`), covariance ``p`` and correction ``res`` of fix ``j`` in ``out``."""
+    out.c[j], out.v[j], out.pos[j], out.cov[j] = nav.c, nav.v, nav.pos, p
+    out.bias[j, 0:3], out.bias[j, 3:6], out.lever[j] = nav.bg, nav.ba, nav.lever
+    out.nis[j], out.w[j], out.gamma[j], out.margin[j], out.status[j] = res[2], res[3], res[4], res[5], res[6]
 
 
-def allocate(m, n):
-    """Output arrays at the M GNSS epochs for n states."""
-    return (np.full((m, 3, 3), np.nan), np.full((m, 3), np.nan), np.full((m, 3), np.nan),
-            np.full((m, n, n), np.nan), np.full((m, 6), np.nan), np.full((m, 3), np.nan), np.full(m, np.nan),
-            np.full(m, np.nan), np.full(m, np.nan), np.full((m, 6), np.nan), np.full(m, -1, dtype=np.int64))
+def allocate(m, n, k_att, k_dd) -> Outputs:
+    """Output arrays at the M GNSS epochs for n states, and the NIS of K attitude and D DD updates (NaN)."""
+    return Outputs(np.full((m, 3, 3), np.nan), np.full((m, 3), np.nan), np.full((m, 3), np.nan),
+                   np.full((m, n, n), np.nan), np.full((m, 6), np.nan), np.full((m, 3), np.nan), np.full(m, np.nan),
+                   np.full(m, np.nan), np.full(m, np.nan), np.full((m, 6), np.nan), np.full(m, -1, dtype=np.int64),
+                   np.full(k_att, np.nan), np.full(k_dd, np.nan))
 
 
 @njit(cache=True)
-def run(phi, dvb, dt, w_ib, w_mean, nav0, p, qc, cov_dt, gnss, att, dd, mode, alpha, out, att_nis, dd_nis):
-    """The recursion over the compensated increments ``phi``, ``dvb``, ``dt`` and the body rate ``w_ib`` (N, 3)
-    rad/s at each sample (:class:`.increments.Compensated`; a fix at sample s predicts its lever velocity with
-    w_ib[s], H's lever rows use the trailing mean ``w_mean`` (N, 3): :func:`_pv_rows`). ``nav0`` = (C, v, pos,
-    bg, ba, lever); ``gnss`` = (k (M,) sample index, z (M, 6) [L, lambda, h, vE, vN, vU], R (M, 6, 6)); ``att`` =
-    (k (K,), z (K, 3), R (K, 3, 3)); ``dd`` = (k (D,), row offsets (D + 1,), G (T, 3), body baselines (T, 3) m,
-    ranges (T,) m, covariance offsets, covariance blocks m^2, NIS gate (D,)). Fills out, att_nis (K,), dd_nis (D,)."""
+def run(imu, nav0, tuning, gnss, att, dd, out):
+    """The recursion over the compensated IMU ``imu`` (:class:`Samples`; a fix at sample s predicts its lever velocity
+    with w_ib[s], H's lever rows use the trailing mean w_mean: :func:`_pv_rows`) from ``nav0`` (:class:`Nav`)
+    with ``tuning`` (:class:`Tuning`), position/velocity fixes ``gnss`` and attitude fixes ``att``
+    (:class:`Fixes`) and the fixed DD carrier ``dd`` (:class:`DDRows`). Fills ``out`` (:class:`Outputs`)."""
+    phi, dvb, dt, w_ib, w_mean = imu
     c, v, pos, bg, ba, lever = nav0
+    p, qc, cov_dt, mode, alpha = tuning
     gk, gz, gr = gnss
     ak, az, ar = att
-    dk = dd[0]
+    dk = dd.k
     v_prev = v.copy()
     fsum, tacc = np.zeros(3), 0.0
     ig, ia, idd = 0, 0, 0
@@ -128,17 +208,17 @@ def run(phi, dvb, dt, w_ib, w_mean, nav0, p, qc, cov_dt, gnss, att, dd, mode, al
                 continue
             res = kalman.correct_hinf(np.zeros(p.shape[0]), p, nu, h, r, alpha, mode == 2) if mode >= 1 else \
                 _kalman(p, nu, h, r)
-            gated = kind == 1 and not res[2] <= dd[7][idd]  # DD innovation gate (inf: off): state left alone
+            gated = kind == 1 and not res[2] <= dd.gate[idd]  # DD innovation gate (inf: off): state left alone
             if not gated:
                 p = res[1]
                 c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
             if kind == 0:
-                att_nis[ia] = res[2]
+                out.att_nis[ia] = res[2]
                 ia += 1
             elif kind == 1:
-                dd_nis[idd] = res[2]
+                out.dd_nis[idd] = res[2]
                 idd += 1
             else:
-                _record(out, ig, c, v, pos, p, bg, ba, lever, res)
+                _record(out, ig, Nav(c, v, pos, bg, ba, lever), p, res)
                 ig += 1
     return out

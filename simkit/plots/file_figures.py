@@ -8,7 +8,7 @@ import numpy as np
 
 from .. import frames
 from ..errors import SimkitError
-from ..io import open_dataset, solution_names
+from ..io import gnss_signals, has, n_samples, open_dataset, read_gnss, read_imu, read_truth, solution_names
 from .common import draw, require_matplotlib, skip_line
 
 MAX_POINTS = 20_000        # truth samples drawn per curve (strided beyond that)
@@ -20,12 +20,18 @@ def _stride(n: int, limit: int) -> int:
     return max(1, -(-n // limit))
 
 
+def _every(ds) -> slice:
+    """The GNSS epochs drawn: every k-th, at most MAX_EPOCHS."""
+    return slice(None, None, _stride(n_samples(ds, "gnss"), MAX_EPOCHS))
+
+
 def _trajectory(plt, ds):
-    if "truth/pos_lla" not in ds:
+    if not has(ds, "truth", "pos_lla"):
         return None
-    k = _stride(len(ds["truth/t"]), MAX_POINTS)
-    t, lla = ds["truth/t"][::k], ds["truth/pos_lla"][::k]
-    enu = frames.ecef_to_enu_vec(ds["truth/pos_ecef"][::k] - ds["truth/pos_ecef"][0], lla[0, 0], lla[0, 1])
+    k = _stride(n_samples(ds, "truth"), MAX_POINTS)
+    tr = read_truth(ds, fields=("pos_lla", "pos_ecef"), required=("pos_lla", "pos_ecef"), epochs=slice(None, None, k))
+    t, lla = tr.t, tr.pos_lla
+    enu = frames.ecef_to_enu_vec(tr.pos_ecef - tr.pos_ecef[0], lla[0, 0], lla[0, 1])
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1.2, 1]})
     a.plot(enu[:, 0] / 1e3, enu[:, 1] / 1e3, lw=1, label="truth")
     a.plot(enu[0, 0] / 1e3, enu[0, 1] / 1e3, "go", label="start")
@@ -45,11 +51,11 @@ def _trajectory(plt, ds):
 
 
 def _sky(plt, ds):
-    if "gnss/truth/elevation" not in ds:
+    if not has(ds, "gnss_truth", "elevation"):
         return None
-    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
-    el, az = ds["gnss/truth/elevation"][::k, 0], ds["gnss/truth/azimuth"][::k, 0]
-    ids = [str(s) for s in ds["gnss/sat_id"][:]]
+    g = read_gnss(ds, signals=(), antennas=0, epochs=_every(ds), truth=("elevation", "azimuth"), satellites=False)
+    el, az = g.truth["elevation"], g.truth["azimuth"]
+    ids = [str(s) for s in g.sat_id]
     fig = plt.figure(figsize=(6.5, 6.5))
     ax = fig.add_subplot(projection="polar")
     ax.set_theta_zero_location("N")
@@ -72,16 +78,14 @@ def _sky(plt, ds):
 
 
 def _dops(plt, ds):
-    if "gnss/truth/elevation" not in ds:
+    if not has(ds, "gnss_truth", "elevation"):
         return None
     from ..constellation import dops
 
-    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
-    t = ds["gnss/t"][::k]
-    el, az = ds["gnss/truth/elevation"][::k, 0], ds["gnss/truth/azimuth"][::k, 0]
-    signals = [str(s) for s in ds["gnss/signals"][:]]
-    tracked = np.any([np.isfinite(ds[f"gnss/obs/{s}/code"][::k, 0]) for s in signals], axis=0)
-    system = np.array([str(s)[0] for s in ds["gnss/sat_id"][:]])
+    g = read_gnss(ds, antennas=0, epochs=_every(ds), obs=("code",), truth=("elevation", "azimuth"), satellites=False)
+    t, el, az = g.t, g.truth["elevation"], g.truth["azimuth"]
+    tracked = np.any([np.isfinite(g.obs["code"][s]) for s in g.signals], axis=0)
+    system = np.array([str(s)[0] for s in g.sat_id])
     d = dops(np.where(tracked, el, np.nan), az, 0.0, system)
     fig, (a, b) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, layout="constrained")
     for code, name in (("G", "GPS"), ("C", "BeiDou")):
@@ -101,7 +105,7 @@ def _dops(plt, ds):
 
 
 def _allan(plt, ds):
-    if "imu/gyro" not in ds or "truth/omega_ib_b" not in ds or len(ds["imu/t"]) < 100:
+    if not has(ds, "imu", "gyro") or not has(ds, "truth", "omega_ib_b") or n_samples(ds, "imu") < 100:
         return None
     from ..imu.allan import adev
 
@@ -109,8 +113,10 @@ def _allan(plt, ds):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), layout="constrained")
     for ax, (name, truth, unit, scale) in zip(axes, (("gyro", "omega_ib_b", "deg/h", 180 / np.pi * 3600),
                                                       ("accel", "f_ib_b", "m/s^2", 1.0))):
-        n = min(len(ds["imu/t"]), MAX_ALLAN)
-        taus, dev, _ = adev(ds[f"imu/{name}"][:n] - ds[f"truth/{truth}"][:n], dt)
+        n = min(n_samples(ds, "imu"), MAX_ALLAN)
+        measured = getattr(read_imu(ds, fields=(name,), epochs=slice(0, n)), name)
+        taus, dev, _ = adev(measured - getattr(read_truth(ds, fields=(truth,), required=(truth,),
+                                                          epochs=slice(0, n)), truth), dt)
         for a, axis in enumerate("xyz"):
             ax.loglog(taus, dev[:, a] * scale, ".-", ms=3, label=f"{axis} axis")
         ax.set_xlabel("averaging time tau [s]")
@@ -122,16 +128,17 @@ def _allan(plt, ds):
 
 
 def _observations(plt, ds):
-    signals = [str(s) for s in ds["gnss/signals"][:]] if "gnss/signals" in ds else []
-    if not signals or f"gnss/truth/{signals[0]}/noise_code" not in ds:
+    signals = gnss_signals(ds)
+    if not signals or not has(ds, "gnss_truth", f"{signals[0]}/noise_code"):
         return None
-    k = _stride(len(ds["gnss/t"]), MAX_EPOCHS)
-    t = ds["gnss/t"][::k]
+    terms = [f"{s}/{e}_{kind}" for s in signals for e in ("noise", "multipath") for kind in ("code", "carrier")]
+    g = read_gnss(ds, antennas=0, epochs=_every(ds), obs=("code", "carrier"), truth=terms, satellites=False)
+    t = g.t
     fig, axes = plt.subplots(len(signals), 2, figsize=(11, 3.2 * len(signals)), squeeze=False, layout="constrained")
     for row, sig in zip(axes, signals):
         for ax, kind in zip(row, ("code", "carrier")):
-            err = ds[f"gnss/truth/{sig}/noise_{kind}"][::k, 0] + ds[f"gnss/truth/{sig}/multipath_{kind}"][::k, 0]
-            err = np.where(np.isfinite(ds[f"gnss/obs/{sig}/{kind}"][::k, 0]), err, np.nan)
+            err = g.truth[f"{sig}/noise_{kind}"] + g.truth[f"{sig}/multipath_{kind}"]
+            err = np.where(np.isfinite(g.obs[kind][sig]), err, np.nan)
             ax.plot(t, err * (1.0 if kind == "code" else 1e3), ".", ms=2)
             ax.plot([], [], ".", label="one colour per satellite")
             ax.set_ylabel(f"{sig} {kind} [{'m' if kind == 'code' else 'mm'}]")

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..io import open_dataset
+from ..io import has, open_dataset, read_gnss, read_imu
 from .errors import RefereeInputError
 from .score import Score, score
 from .spec import Spec
@@ -88,23 +88,20 @@ class RunResult:
     timing: dict
 
 
+OBS_KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 BLOCK_EPOCHS = 600   # GNSS epochs (and the IMU samples between them) read at a time: bounded memory
 
 
 def _gnss_block(ds, m0: int, m1: int) -> dict:
     """GNSS epochs m0..m1 of the file as arrays (per signal and kind for the observations)."""
-    signals = [str(s) for s in ds["gnss/signals"][:]]
-    out = {"t": ds["gnss/t"][m0:m1], "sat_id": tuple(str(s) for s in ds["gnss/sat_id"][:]),
-           "sat_pos_ecef": ds["gnss/sat_pos_ecef"][m0:m1], "sat_clock": ds["gnss/sat_clock"][m0:m1],
-           "lever_arm_b": ds["gnss/antennas/lever_arm_b"][:],
-           "wavelength_m": dict(zip(signals, ds["gnss/wavelength_m"][:].tolist()))}
-    for kind in ("code", "carrier", "doppler", "cn0", "lli"):
-        out[kind] = {s: ds[f"gnss/obs/{s}/{kind}"][m0:m1] for s in signals}
-    return out
+    g = read_gnss(ds, epochs=slice(m0, m1), obs=OBS_KINDS)
+    return {"t": g.t, "sat_id": tuple(str(s) for s in g.sat_id), "sat_pos_ecef": g.sat_pos_ecef,
+            "sat_clock": g.sat_clock, "lever_arm_b": g.lever_arm_b,
+            "wavelength_m": dict(zip(g.signals, g.wavelength_m.tolist())), **g.obs}
 
 
 def _epoch(g: dict, m: int, week: int, sow: float) -> GnssEpoch:
-    per = {kind: {s: x[m] for s, x in g[kind].items()} for kind in ("code", "carrier", "doppler", "cn0", "lli")}
+    per = {kind: {s: x[m] for s, x in g[kind].items()} for kind in OBS_KINDS}
     t = float(g["t"][m])
     return GnssEpoch(t, g["sat_id"], g["sat_pos_ecef"][m], g["sat_clock"][m], g["lever_arm_b"], **per,
                      wavelength_m=g["wavelength_m"], gps_week=week + int((sow + t) // 604800),
@@ -112,7 +109,7 @@ def _epoch(g: dict, m: int, week: int, sow: float) -> GnssEpoch:
 
 
 def _check_file(ds, path):
-    if "imu/gyro" not in ds or "gnss/t" not in ds:
+    if not has(ds, "imu", "gyro") or not has(ds, "gnss", "t"):
         raise RefereeInputError(path, "the plugin runner needs /imu and /gnss (a scenario with [imu] and [gnss])")
 
 
@@ -127,7 +124,7 @@ def _start(flt, ds, truth, t0: float, start):
     if callable(getattr(flt, "start", None)):
         i = int(np.searchsorted(truth.t, t0))
         flt.start(TrueInitialState(float(truth.t[i]), truth.pos_ecef[i], truth.vel_enu[i], truth.quat_nb[i],
-                               ds["gnss/antennas/lever_arm_b"][:], *start))
+                                   truth.lever_arm_b, *start))
 
 
 def _feed(flt, ds, t_imu, n: int, start, clock: dict, bar) -> int:
@@ -135,7 +132,7 @@ def _feed(flt, ds, t_imu, n: int, start, clock: dict, bar) -> int:
     samples of a block of GNSS epochs are read at once); returns the number of GNSS epochs."""
     nominal = t_imu[1] - t_imu[0] if n > 1 else 0.0
     dt = np.diff(t_imu[:n], prepend=t_imu[0] - nominal)
-    t_gnss = ds["gnss/t"][:]
+    t_gnss = read_gnss(ds, satellites=False).t
     n_epochs = int(np.searchsorted(t_gnss, t_imu[n - 1], side="right"))
     after = np.searchsorted(t_imu[:n], t_gnss[:n_epochs], side="right")   # IMU samples before each epoch
     k0 = 0
@@ -144,11 +141,11 @@ def _feed(flt, ds, t_imu, n: int, start, clock: dict, bar) -> int:
         g = _gnss_block(ds, m0, m1)
         ends = [*after[m0:m1], *([n] if m1 == n_epochs else [])]
         base, top = k0, (ends[-1] if ends else k0)
-        gyro, accel = ds["imu/gyro"][base:top], ds["imu/accel"][base:top]
+        imu = read_imu(ds, fields=("gyro", "accel"), epochs=slice(base, top))
         for j, k1 in enumerate(ends):
             c0 = time.perf_counter()
             for k in range(k0, k1):
-                flt.predict(ImuSample(float(t_imu[k]), float(dt[k]), gyro[k - base], accel[k - base]))
+                flt.predict(ImuSample(float(t_imu[k]), float(dt[k]), imu.gyro[k - base], imu.accel[k - base]))
             c1 = time.perf_counter()
             if j < m1 - m0:
                 flt.update(_epoch(g, j, *start))
@@ -168,7 +165,7 @@ def run_filter(flt, path, spec: Spec | None = None, duration_s: float | None = N
     _check_filter(flt)
     with open_dataset(path) as ds:
         _check_file(ds, path)
-        t_imu = ds["imu/t"][:]
+        t_imu = read_imu(ds, fields=()).t
         n = len(t_imu) if duration_s is None else int(np.searchsorted(t_imu, t_imu[0] + duration_s, side="right"))
         start = (int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]))
         truth = read_truth(path, t_imu[0], t_imu[n - 1])

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import open_dataset
+from ..io import gnss_signals, has, members, open_dataset, read_gnss, read_imu, read_truth
 from .errors import RefereeInputError
 
 GOLDEN = Path(__file__).resolve().parents[1] / "data" / "golden" / "regress.json"
@@ -49,15 +49,20 @@ def _axes(prefix: str, x: np.ndarray, fn=np.std) -> dict[str, float]:
     return {f"{prefix}[{a}]": float(v) for a, v in zip("xyz", fn(x, axis=0))}
 
 
+NOISE_TERMS = ("noise_code", "noise_carrier", "noise_doppler", "multipath_code", "multipath_carrier")
+
+
 def _gnss_statistics(ds) -> dict[str, float]:
     out = {}
-    for sig in (str(s) for s in ds["gnss/signals"][:]):
-        tracked = np.isfinite(ds[f"gnss/obs/{sig}/code"][:])
+    for sig in gnss_signals(ds):
+        g = read_gnss(ds, signals=[sig], obs=("code", "cn0"), truth=[f"{sig}/{t}" for t in NOISE_TERMS],
+                      satellites=False)
+        tracked = np.isfinite(g.obs["code"][sig])
         out[f"gnss/{sig}/tracked.mean"] = float(tracked.sum(axis=-1).mean())
-        out[f"gnss/{sig}/cn0.mean"] = float(np.nanmean(ds[f"gnss/obs/{sig}/cn0"][:]))
-        for term in ("noise_code", "noise_carrier", "noise_doppler", "multipath_code", "multipath_carrier"):
-            if f"gnss/truth/{sig}/{term}" in ds:
-                out[f"gnss/{sig}/{term}.std"] = float(np.nanstd(ds[f"gnss/truth/{sig}/{term}"][:][tracked]))
+        out[f"gnss/{sig}/cn0.mean"] = float(np.nanmean(g.obs["cn0"][sig]))
+        for term in NOISE_TERMS:
+            if f"{sig}/{term}" in g.truth:
+                out[f"gnss/{sig}/{term}.std"] = float(np.nanstd(g.truth[f"{sig}/{term}"][tracked]))
     return out
 
 
@@ -65,14 +70,17 @@ def statistics(path) -> dict[str, float]:
     """The named regression quantities of a simkit file (module docstring), SI units."""
     out = {}
     with open_dataset(path) as ds:
+        truth = read_truth(ds, fields=("pos_ecef", "vel_enu", "euler", "omega_ib_b", "f_ib_b"),
+                           required=("pos_ecef", "vel_enu", "euler"))
         for key in ("pos_ecef", "vel_enu", "euler"):
-            out.update({f"truth/{key}[-1][{i}]": float(v) for i, v in enumerate(ds[f"truth/{key}"][-1])})
-        if "imu/gyro" in ds:
-            out.update(_axes("imu/gyro-truth.std", ds["imu/gyro"][:] - ds["truth/omega_ib_b"][:]))
-            out.update(_axes("imu/accel-truth.std", ds["imu/accel"][:] - ds["truth/f_ib_b"][:]))
-            for term in ds.members("imu/errors"):
-                out.update(_axes(f"imu/errors/{term}.std", ds[f"imu/errors/{term}"][:]))
-        if "gnss/signals" in ds:
+            out.update({f"truth/{key}[-1][{i}]": float(v) for i, v in enumerate(getattr(truth, key)[-1])})
+        if has(ds, "imu", "gyro"):
+            imu = read_imu(ds, fields=("gyro", "accel"), errors=members(ds, "imu_errors"))
+            out.update(_axes("imu/gyro-truth.std", imu.gyro - truth.omega_ib_b))
+            out.update(_axes("imu/accel-truth.std", imu.accel - truth.f_ib_b))
+            for term, x in imu.errors.items():
+                out.update(_axes(f"imu/errors/{term}.std", x))
+        if gnss_signals(ds):
             out.update(_gnss_statistics(ds))
     return out
 

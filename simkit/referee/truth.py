@@ -11,49 +11,26 @@ with w_eb^b = w_ib^b - C_n^b w_ie^n (the body rate w.r.t. the Earth), as the GNS
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 
 from .. import frames
-from ..io import open_dataset
+from ..io import TRUTH_CORE, Truth, has, open_dataset
+from ..io import read_truth as read_file_truth
 from ..solution import parse_point
 from . import quat
 from .errors import RefereeInputError
 
 
-@dataclass(frozen=True)
-class Truth:
-    """N truth samples: ``t`` (N,) s since start; ``pos_ecef`` (N, 3) m; ``vel_enu`` (N, 3) m/s (Earth-relative,
-    ENU at the position); ``quat_nb`` (N, 4) body->ENU scalar-last; ``omega_ib_b`` (N, 3) rad/s body rate
-    w.r.t. inertial space (None when not read); ``lever_arm_b`` (A, 3) m the file's antenna lever arms (None
-    when the file has no /gnss)."""
-
-    t: np.ndarray
-    pos_ecef: np.ndarray
-    vel_enu: np.ndarray
-    quat_nb: np.ndarray
-    omega_ib_b: np.ndarray | None = None
-    lever_arm_b: np.ndarray | None = None
-
-
 def read_truth(path, t_min: float | None = None, t_max: float | None = None) -> Truth:
-    """``/truth/t``, ``pos_ecef``, ``vel_enu`` and ``quat_nb`` of the simkit file ``path``; with ``t_min`` /
-    ``t_max`` (s) only the samples that bracket that span are read (bounded memory for long files)."""
+    """The truth (:class:`simkit.io.Truth`: ``t``, ``pos_ecef``, ``vel_enu``, ``quat_nb``, ``omega_ib_b`` when
+    present, the antenna lever arms) of the simkit file ``path``; with ``t_min`` / ``t_max`` (s) only the
+    samples that bracket that span are read (bounded memory for long files)."""
     with open_dataset(path) as ds:
-        missing = [k for k in ("t", "pos_ecef", "vel_enu", "quat_nb") if f"truth/{k}" not in ds]
+        missing = [k for k in ("t",) + TRUTH_CORE if not has(ds, "truth", k)]
         if missing:
             raise RefereeInputError(path, f"no /truth/{missing[0]} dataset: scoring needs the truth trajectory")
-        t = ds["truth/t"][:]
-        lo = 0 if t_min is None else max(int(np.searchsorted(t, t_min, side="right")) - 1, 0)
-        hi = len(t) if t_max is None else min(int(np.searchsorted(t, t_max, side="left")) + 1, len(t))
-        if hi - lo < 2:   # the span misses the truth: keep two samples so that overlap() names the spans
-            lo, hi = 0, len(t)
-        omega = ds["truth/omega_ib_b"][lo:hi] if "truth/omega_ib_b" in ds else None
-        lever = ds["gnss/antennas/lever_arm_b"][:] if "gnss/antennas/lever_arm_b" in ds else None
-        return Truth(t[lo:hi], *(ds[f"truth/{k}"][lo:hi] for k in ("pos_ecef", "vel_enu", "quat_nb")),
-                     omega, lever)
+        return read_file_truth(ds, span=(t_min, t_max))
 
 
 def overlap(truth: Truth, t: np.ndarray, where: str = "estimate") -> np.ndarray:

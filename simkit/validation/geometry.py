@@ -13,6 +13,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from .. import gpstime
 from ..constellation.geometry import lines_of_sight_enu
+from ..io import has, path_of, read_gnss, read_truth
 from .errors import ValidationInputError
 
 
@@ -80,33 +81,37 @@ def from_scenario(sc, progress: bool = False) -> ValidationGeometry:
                     f"scenario {sc.name} ({', '.join(sky.sources)})")
 
 
+NEEDED = (("gnss", "t"), ("gnss", "sat_pos_ecef"), ("gnss_truth", "antenna_pos_ecef"), ("antennas", "lever_arm_b"),
+          ("truth", "t"), ("truth", "quat_nb"), ("gnss", "sat_id"))
+
+
 def from_file(ds) -> ValidationGeometry:
     """Geometry of an open simkit file ``ds`` (:func:`simkit.open`): /gnss/sat_pos_ecef, antenna 0 of
     /gnss/truth/antenna_pos_ecef, /truth/quat_nb interpolated (slerp) to /gnss/t; visible = the satellite's
     carrier is tracked at every antenna on the first signal (else elevation above 0)."""
-    need = ("gnss/t", "gnss/sat_pos_ecef", "gnss/truth/antenna_pos_ecef", "gnss/antennas/lever_arm_b",
-            "truth/t", "truth/quat_nb", "gnss/sat_id")
-    missing = [p for p in need if p not in ds]
+    missing = [path_of(g, n) for g, n in NEEDED if not has(ds, g, n)]
     if missing:
-        raise ValidationInputError(f"{ds.path}: /{missing[0]}: missing; the validation needs {', '.join(need)}")
-    t = ds["gnss/t"][:]
-    rx = ds["gnss/truth/antenna_pos_ecef"][:, 0, :]
-    tq, q = ds["truth/t"][:], ds["truth/quat_nb"][:]
+        raise ValidationInputError(f"{ds.path}: /{missing[0]}: missing; the validation needs "
+                                   f"{', '.join(path_of(g, n) for g, n in NEEDED)}")
+    signals = ds.groups(path_of("obs"))
+    g = read_gnss(ds, signals=signals[:1], obs=("carrier",) if signals else (), truth=("antenna_pos_ecef",))
+    t, rx = g.t, g.truth["antenna_pos_ecef"][:, 0, :]
+    truth = read_truth(ds, fields=("quat_nb",), required=("quat_nb",))
+    tq, q = truth.t, truth.quat_nb
     quat = Slerp(tq, Rotation.from_quat(q))(np.clip(t, tq[0], tq[-1])).as_quat() if len(tq) > 1 else \
         np.broadcast_to(q[0], (len(t), 4))
-    los, el = body_los(ds["gnss/sat_pos_ecef"][:], rx, quat)
-    signals = ds.groups("gnss/obs")
+    los, el = body_los(g.sat_pos_ecef, rx, quat)
     if signals:
-        vis = np.isfinite(ds[f"gnss/obs/{signals[0]}/carrier"][:]).all(axis=1)
+        vis = np.isfinite(g.obs["carrier"][signals[0]]).all(axis=1)
     else:
         vis = np.isfinite(el) & (el > 0)
-    arms = ds["gnss/antennas/lever_arm_b"][:]
+    arms = g.lever_arm_b
     if len(arms) < 2:
         raise ValidationInputError(f"{ds.path}: /gnss/antennas/lever_arm_b: expected at least 2 antennas, found "
                                    f"{len(arms)}")
     return ValidationGeometry(t, int(ds.attrs.get("start_gps_week", 0)), float(ds.attrs.get("start_gps_sow", 0.0)),
-                    tuple(ds["gnss/sat_id"][:].tolist()), los, el, vis & np.isfinite(el), arms,
-                    f"file {ds.path.name} (scenario {ds.scenario_name})")
+                              tuple(g.sat_id.tolist()), los, el, vis & np.isfinite(el), arms,
+                              f"file {ds.path.name} (scenario {ds.scenario_name})")
 
 
 def select_systems(geo: ValidationGeometry, systems: str) -> ValidationGeometry:
