@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 import simkit
-from simkit.estimators import EstimatorInputError, spp
+from simkit.estimators import spp
+from simkit.gnss.spp import SppInputError
 from simkit.estimators.registry import DEFAULTS, spp_fixes
 from simkit.frames import ecef_to_enu_vec, ecef_to_lla
 
@@ -100,6 +101,6 @@ def test_too_few_satellites_give_nan_not_a_fix():
 
 
 def test_shape_errors_name_the_arrays():
-    with pytest.raises(EstimatorInputError, match="sat_pos_ecef"):
+    with pytest.raises(SppInputError, match="sat_pos_ecef"):
         spp(np.arange(2.0), np.zeros((2, 4)), np.zeros((2, 4)), np.ones(4), np.zeros((2, 3, 3)),
             np.zeros((2, 4)), np.array(["G"] * 4))

@@ -75,7 +75,7 @@ def read(ds, p: dict) -> FileData:
     code = np.stack([g.obs["code"][s] for s in names])
     with warnings.catch_warnings():  # a satellite no signal tracks: its mean is NaN, as wanted
         warnings.simplefilter("ignore", RuntimeWarning)
-        receiver = code_position(np.nanmean(code[:, :, 0], axis=0), g.sat_pos_ecef, g.sat_clock)
+        receiver = code_position(np.nanmean(code[:, :, 0], axis=0), g.sat_pos_ecef, g.sat_clock, g.sat_id)
     los, el = lines_of_sight(receiver, g.sat_pos_ecef)
     sigs = [gsig.get(s) for s in names]
     lam = np.array([s.wavelength_m for s in sigs])

@@ -9,7 +9,7 @@ from .filters import FilterConfig, HInfinityFilter, KalmanFilter15, KalmanFilter
 from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData, InitialState
 from .kalman import Correction, kalman_update
 from .registry import DEFAULTS, SOLVERS
-from .spp import SppFixes, spp
+from ..gnss.spp import SppFixes, spp
 from .strapdown import strapdown
 
 __all__ = ["AttitudeFixes", "Correction", "DDCarrier", "DEFAULTS", "EstimatorInputError", "FilterConfig",

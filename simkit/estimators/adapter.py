@@ -10,17 +10,14 @@ import json
 import numpy as np
 
 from .. import attitude as gnss_attitude
+from ..gnss.differencing import systems_of
+from ..gnss.spp import SppFixes, spp
 from ..io import broadcast_ionosphere as file_ionosphere
 from ..io import has, n_antennas, read_gnss, read_imu
 from .errors import EstimatorInputError
 from .filters import FilterConfig
 from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData
-from .spp import SppFixes, spp
 from .truth_inputs import truth_attitude, truth_fixes
-
-
-def _system_of(sat_ids):
-    return np.array([s[0] for s in sat_ids])
 
 
 def antenna(ds, p) -> int:
@@ -57,7 +54,7 @@ def spp_fixes(ds, p):
         code[:, take], doppler[:, take], wl[take], gd[take] = c[:, take], d[:, take], g.wavelength_m[j], \
             g.group_delay[take, j]
     iono, why = broadcast_ionosphere(ds, p)
-    fx = spp(g.t, code, doppler, wl, g.sat_pos_ecef, g.sat_clock, _system_of(g.sat_id), gd,
+    fx = spp(g.t, code, doppler, wl, g.sat_pos_ecef, g.sat_clock, systems_of(g.sat_id), gd,
              p["elevation_mask_deg"], p["sigma_code_m"], p["sigma_doppler_m_per_s"], iono_coefficients=iono,
              gps_sow=float(ds.attrs["start_gps_sow"]) + g.t)
     return SppFixes(**{**fx.__dict__, "ionosphere": why})
