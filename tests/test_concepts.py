@@ -1,5 +1,6 @@
-"""One owner per small concept: angle wrap, skew matrix, Euler Jacobian, Sagnac rotation and the physical
-constants are defined once (a lower layer) and checked against closed forms."""
+"""One owner per small concept: angle wrap, skew matrix, Euler Jacobian, Sagnac rotation, single-point positioning,
+the DD float solution and the physical constants are defined once (a lower layer) and checked against closed
+forms."""
 import ast
 from pathlib import Path
 
@@ -13,7 +14,9 @@ PKG = Path(__file__).resolve().parents[1] / "simkit"
 # concept -> the modules allowed to define it; nav.skew is the compiled one-vector form the filter kernels call
 OWNERS = {"wrap": {"frames.py"}, "skew": {"frames.py", "estimators/nav.py"}, "euler_jacobian": {"frames.py"},
           "sagnac_rotate": {"constellation/geometry.py"}, "dd_operator": {"gnss/differencing.py"},
-          "dd_matrix": {"gnss/differencing.py"}}
+          "dd_matrix": {"gnss/differencing.py"}, "spp": {"gnss/spp.py"}, "dd_float": {"gnss/differencing.py"},
+          "symmetric": {"gnss/differencing.py"}, "systems_of": {"gnss/differencing.py"},
+          "_gauss_newton": set()}
 CONSTANTS = {"C_LIGHT", "OMEGA_E", "G0", "GM", "A", "F", "E2"}
 WGS84_OMEGA_E = 7.292115e-5  # rad/s, NIMA TR8350.2 table 3.1
 C = 299792458.0              # m/s, exact by the SI definition of the metre
@@ -126,3 +129,27 @@ def test_dd_operator_from_any_reference_antenna_equals_the_double_differences():
         rows = np.searchsorted(np.delete(np.arange(3), ref_antenna), ant)
         assert np.allclose(D @ x[0].reshape(-1), dd[rows, sat], rtol=0, atol=1e-14)
         assert sorted(set(sat)) == [0, 1, 4] and np.array_equal(ant, np.repeat(np.delete(np.arange(3), ref_antenna), 3))
+
+
+def test_the_dd_float_solution_of_equal_sigmas_is_the_joint_least_squares_of_carrier_and_code():
+    """gnss.differencing.float_solution goes through dd_float (code-only baseline); the joint least squares of
+    carrier and code with free ambiguities (normal equations written out here) gives the same estimate."""
+    from simkit.gnss.differencing import _between_satellite_cofactor, float_solution
+    rng = np.random.default_rng(4)
+    T, r, n, lam, sp, sc = 3, 2, 6, 0.19, 0.003, 0.3
+    G = rng.normal(size=(T, n, 3))
+    car, code = rng.normal(size=(T, r, n)) * 10, rng.normal(size=(T, r, n))
+    fs = float_solution(G, car, code, lam, sp, sc)
+    Ci = np.linalg.inv(np.kron(np.eye(r) + np.ones((r, r)), _between_satellite_cofactor(n)))
+    for t in range(T):
+        Gr = np.kron(np.eye(r), G[t])
+        A = np.block([[lam * np.eye(r * n), Gr], [np.zeros((r * n, r * n)), Gr]])
+        W = np.block([[Ci / sp**2, np.zeros_like(Ci)], [np.zeros_like(Ci), Ci / sc**2]])
+        y = np.concatenate([lam * car[t].ravel(), code[t].ravel()])
+        Q = np.linalg.inv(A.T @ W @ A)
+        x = np.linalg.solve(A.T @ W @ A, A.T @ W @ y)
+        assert np.allclose(fs.a_hat[t], x[:r * n], rtol=0, atol=1e-7)
+        assert np.allclose(fs.b_hat[t], x[r * n:], rtol=0, atol=1e-8)
+        assert np.allclose(fs.Qa[t], Q[:r * n, :r * n], rtol=1e-7, atol=0)
+        assert np.allclose(fs.Qb[t], Q[r * n:, r * n:], rtol=1e-7, atol=0)
+        assert np.allclose(fs.Qba[t], Q[r * n:, :r * n], rtol=1e-7, atol=1e-12)

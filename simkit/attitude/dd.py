@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..gnss.differencing import dd_matrix, systems_of
+from ..gnss.differencing import dd_float, dd_matrix, symmetric, systems_of
 from .errors import AttitudeInputError
 
 
@@ -172,11 +172,6 @@ def _window_sum(x: np.ndarray, start: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
-def symmetric(P: np.ndarray) -> np.ndarray:
-    """The symmetric part of a stack of matrices (..., n, n): removes the rounding asymmetry of a product."""
-    return 0.5 * (P + np.swapaxes(P, -1, -2))
-
-
 def _window_mean(x: np.ndarray, info: np.ndarray, start: np.ndarray, n: int):
     """Information-weighted mean (K, d) and its covariance (K, d, d) of the estimates ``x`` (K, d) with
     information matrices ``info`` (K, d, d) over each epoch's window of the last ``n`` epochs of its run."""
@@ -228,13 +223,5 @@ def _solve_group(obs: Observations, epochs, signal, sat, ref, correlated: bool =
     G = np.zeros((len(epochs), r * n, 3 * r))
     for k in range(r):
         G[:, k * n:(k + 1) * n, 3 * k:3 * k + 3] = G1
-    GtW = np.swapaxes(np.linalg.solve(Qp, G), 1, 2)  # G' Qp^-1
-    Qb = np.linalg.inv(GtW @ G)
-    Qb = symmetric(Qb)
-    b_hat = np.einsum("kij,kj->ki", Qb @ GtW, y_p)
-    a_hat = (y_phi - np.einsum("kij,kj->ki", G, b_hat)) / lam
-    GQb = G @ Qb
-    Qa = (Qphi + GQb @ np.swapaxes(G, 1, 2)) / np.outer(lam, lam)
-    Qa = symmetric(Qa)
-    Qba = -np.swapaxes(GQb, 1, 2) / lam
-    return FloatGroup(epochs, signal, sat, ref, a_hat, Qa, b_hat, Qb, Qba, G1, Qphi, Qc)
+    f = dd_float(G, y_phi, y_p, Qphi, Qp, lam)
+    return FloatGroup(epochs, signal, sat, ref, f.a_hat, f.Qa, f.b_hat, f.Qb, f.Qba, G1, Qphi, Qc)

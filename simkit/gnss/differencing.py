@@ -133,34 +133,46 @@ def _between_satellite_cofactor(n):
     return 0.5 * Q
 
 
-def float_solution(G, carrier_cycles, code_m, wavelength_m, sigma_phase_m, sigma_code_m) -> FloatSolution:
-    """Least-squares float solution of single-epoch DD carrier and code for r baselines from one master antenna.
+def symmetric(P: np.ndarray) -> np.ndarray:
+    """The symmetric part of a stack of matrices (..., n, n): removes the rounding asymmetry of a product."""
+    return 0.5 * (P + np.swapaxes(P, -1, -2))
 
-    ``G`` (T, n, 3): DD geometry rows (DD range = G b, m per m); ``carrier_cycles`` and ``code_m`` (T, r, n) DDs;
-    sigmas are of undifferenced observations (m). The DD noise of baseline k is D(e_k - e_master) with D the
-    between-satellite difference, so Cov(DD_k, DD_l) = (1 + [k == l]) sigma^2 D D^T; that Kronecker structure
-    gives the same estimator per baseline and Cov(x_k, x_l) = (1 + [k == l]) Qx0.
+
+def dd_float(G, carrier_m, code_m, Q_carrier, Q_code, wavelength_m) -> FloatSolution:
+    """Single-epoch DD float solution, batched over K epochs: the baseline from the code, the ambiguities from the
+    carrier minus it (the carrier's free ambiguity per row leaves it no information on the baseline):
+
+        b = (G' Qp^-1 G)^-1 G' Qp^-1 y_p,  a = L^-1 (y_phi - G b),
+        Qb = (G' Qp^-1 G)^-1,  Qa = L^-1 (Qphi + G Qb G') L^-1,  Qba = -Qb G' L^-1,  L = diag(wavelength).
+
+    ``G`` (K, N, B) m per m (DD range = G b); ``carrier_m``, ``code_m`` (K, N) m; ``Q_carrier``, ``Q_code``
+    (K, N, N) m^2 DD covariances; ``wavelength_m`` (N,) or a scalar. Ambiguities in cycles, baselines in m.
+    """
+    lam = np.broadcast_to(np.asarray(wavelength_m, float), (G.shape[1],))
+    GtW = np.swapaxes(np.linalg.solve(Q_code, G), 1, 2)  # G' Qp^-1
+    Qb = symmetric(np.linalg.inv(GtW @ G))
+    b_hat = np.einsum("kij,kj->ki", Qb @ GtW, code_m)
+    a_hat = (carrier_m - np.einsum("kij,kj->ki", G, b_hat)) / lam
+    GQb = G @ Qb
+    Qa = symmetric((Q_carrier + GQb @ np.swapaxes(G, 1, 2)) / np.outer(lam, lam))
+    return FloatSolution(a_hat, b_hat, Qa, Qb, -np.swapaxes(GQb, 1, 2) / lam)
+
+
+def float_solution(G, carrier_cycles, code_m, wavelength_m, sigma_phase_m, sigma_code_m) -> FloatSolution:
+    """:func:`dd_float` of single-epoch DD carrier and code of r baselines from one master antenna, each antenna's
+    observations with the same undifferenced sigmas.
+
+    ``G`` (T, n, 3): DD geometry rows of one baseline; ``carrier_cycles`` and ``code_m`` (T, r, n) DDs; sigmas
+    of undifferenced observations (m). The DD noise of baseline k is D(e_k - e_master) with D the
+    between-satellite difference, so Cov(DD_k, DD_l) = (1 + [k == l]) sigma^2 D D^T. Rows baseline-major.
     """
     T, n, _ = G.shape
     r = carrier_cycles.shape[1]
-    C0 = _between_satellite_cofactor(n)
-    Ci = np.linalg.inv(C0)
-    wp, wc = 1.0 / sigma_phase_m**2, 1.0 / sigma_code_m**2
-    lam = wavelength_m
-    # normal equations for x = [a (cycles); b (m)], carrier in metres = lam * carrier_cycles
-    N = np.zeros((T, n + 3, n + 3))
-    N[:, :n, :n] = lam**2 * wp * Ci
-    N[:, :n, n:] = lam * wp * Ci @ G
-    N[:, n:, :n] = np.swapaxes(N[:, :n, n:], 1, 2)
-    N[:, n:, n:] = (wp + wc) * np.swapaxes(G, 1, 2) @ Ci @ G
-    Qx0 = np.linalg.inv(N)
-    Qx0 = 0.5 * (Qx0 + np.swapaxes(Qx0, 1, 2))
-    phi_m = lam * carrier_cycles
-    rhs = np.concatenate([lam * wp * (phi_m @ Ci),
-                          (wp * phi_m + wc * code_m) @ Ci @ G], axis=2)  # (T, r, n + 3)
-    x = np.einsum("tij,trj->tri", Qx0, rhs)
     S = np.eye(r) + np.ones((r, r))
-    Qa = np.einsum("kl,tij->tkilj", S, Qx0[:, :n, :n]).reshape(T, r * n, r * n)
-    Qb = np.einsum("kl,tij->tkilj", S, Qx0[:, n:, n:]).reshape(T, 3 * r, 3 * r)
-    Qba = np.einsum("kl,tij->tkilj", S, Qx0[:, n:, :n]).reshape(T, 3 * r, r * n)
-    return FloatSolution(x[:, :, :n].reshape(T, r * n), x[:, :, n:].reshape(T, 3 * r), Qa, Qb, Qba)
+    C = np.kron(S, _between_satellite_cofactor(n))[None]
+    Gr = np.zeros((T, r * n, 3 * r))
+    for k in range(r):
+        Gr[:, k * n:(k + 1) * n, 3 * k:3 * k + 3] = G
+    carrier = wavelength_m * carrier_cycles.reshape(T, r * n)
+    return dd_float(Gr, carrier, code_m.reshape(T, r * n), np.broadcast_to(sigma_phase_m**2 * C, (T,) + C.shape[1:]),
+                    np.broadcast_to(sigma_code_m**2 * C, (T,) + C.shape[1:]), wavelength_m)
