@@ -16,7 +16,7 @@ OWNERS = {"wrap": {"frames.py"}, "skew": {"frames.py", "estimators/nav.py"}, "eu
           "sagnac_rotate": {"constellation/geometry.py"}, "dd_operator": {"gnss/differencing.py"},
           "dd_matrix": {"gnss/differencing.py"}, "spp": {"gnss/spp.py"}, "dd_float": {"gnss/differencing.py"},
           "symmetric": {"gnss/differencing.py"}, "systems_of": {"gnss/differencing.py"},
-          "_gauss_newton": set()}
+          "_gauss_newton": set(), "truth_at": {"io/readers.py"}, "slerp": {"quat.py"}}
 CONSTANTS = {"C_LIGHT", "OMEGA_E", "G0", "GM", "A", "F", "E2"}
 WGS84_OMEGA_E = 7.292115e-5  # rad/s, NIMA TR8350.2 table 3.1
 C = 299792458.0              # m/s, exact by the SI definition of the metre
@@ -153,3 +153,21 @@ def test_the_dd_float_solution_of_equal_sigmas_is_the_joint_least_squares_of_car
         assert np.allclose(fs.Qa[t], Q[:r * n, :r * n], rtol=1e-7, atol=0)
         assert np.allclose(fs.Qb[t], Q[r * n:, r * n:], rtol=1e-7, atol=0)
         assert np.allclose(fs.Qba[t], Q[r * n:, :r * n], rtol=1e-7, atol=1e-12)
+
+
+def test_truth_at_interpolates_attitude_as_scipy_slerp_and_returns_the_samples_at_their_epochs():
+    from scipy.spatial.transform import Rotation, Slerp
+
+    from simkit.io import Truth, truth_at
+    rng = np.random.default_rng(7)
+    t = np.arange(6.0)
+    q = Rotation.from_rotvec(rng.normal(size=(6, 3)) * 0.5).as_quat()
+    pos = np.array([6378137.0, 0, 0]) + rng.normal(size=(6, 3))
+    truth = Truth(t, pos, rng.normal(size=(6, 3)), q, rng.normal(size=(6, 3)))
+    tk = rng.uniform(0, 5, 40)
+    got = truth_at(truth, tk).quat_nb
+    want = Slerp(t, Rotation.from_quat(q))(tk).as_quat()
+    assert np.allclose(got * np.sign(got[:, 3:]), want * np.sign(want[:, 3:]), rtol=0, atol=1e-12)
+    at = truth_at(truth, t[:-1])
+    assert np.array_equal(at.pos_ecef, pos[:-1]) and np.array_equal(at.omega_ib_b, truth.omega_ib_b[:-1])
+    assert np.allclose(at.quat_nb, q[:-1], rtol=0, atol=1e-15)

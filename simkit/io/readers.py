@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import frames, quat
 from ..errors import DataFileError
 
 # group names of :func:`has`, keyed so that callers need not spell HDF5 paths
@@ -61,6 +62,37 @@ class Truth:
     pos_lla: np.ndarray | None = None
     euler: np.ndarray | None = None
     f_ib_b: np.ndarray | None = None
+
+
+def truth_at(truth: Truth, t) -> Truth:
+    """The truth at epochs ``t`` (K,) s inside its span, the one interpolation every consumer uses.
+
+    Position: cubic Hermite in ECEF with the truth velocity (rotated from ENU to ECEF at each sample) when both are
+    present, so the error is O(jerk dt^4) (below 1 um at 100 Hz for 10 g manoeuvres); linear otherwise. Velocity
+    and body rate: linear (O(jerk dt^2 / 8), < 0.2 mm/s at 100 Hz and 10 m/s^3). Attitude: slerp of the body->ENU
+    quaternions. At a sample time each field is that sample. Fields other than these four are None.
+    """
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    if len(truth.t) == 1:
+        i, s = np.zeros(t.size, int), np.zeros((t.size, 1))
+        j = i
+    else:
+        i = np.clip(np.searchsorted(truth.t, t, side="right") - 1, 0, len(truth.t) - 2)
+        j = i + 1
+        s = ((t - truth.t[i]) / (truth.t[j] - truth.t[i]))[:, None]
+
+    def linear(x):
+        return None if x is None else (1 - s) * x[i] + s * x[j]
+
+    pos = linear(truth.pos_ecef)
+    if truth.pos_ecef is not None and truth.vel_enu is not None and len(truth.t) > 1:
+        lat_lon = frames.ecef_to_lla(truth.pos_ecef[np.r_[i, j]])[:, :2]
+        v = frames.enu_to_ecef_vec(truth.vel_enu[np.r_[i, j]], lat_lon[:, 0], lat_lon[:, 1])
+        h = (truth.t[j] - truth.t[i])[:, None]
+        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+        pos = h00 * truth.pos_ecef[i] + h10 * h * v[:t.size] + h01 * truth.pos_ecef[j] + h11 * h * v[t.size:]
+    att = None if truth.quat_nb is None else quat.slerp(truth.quat_nb[i], truth.quat_nb[j], s)
+    return Truth(t, pos, linear(truth.vel_enu), att, linear(truth.omega_ib_b), truth.lever_arm_b)
 
 
 def truth_rows(t_truth: np.ndarray, t_min: float | None, t_max: float | None) -> slice:

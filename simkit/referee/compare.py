@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from .. import earth, frames
 from ..solution import Solution
-from . import quat
+from .. import quat
 from .errors import RefereeInputError
 from .truth import Truth, at_point, overlap, point_lever, truth_at
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..io import has, open_dataset, read_gnss, read_imu
+from ..io import has, open_dataset, read_gnss, read_imu, truth_at
 from .errors import RefereeInputError
 from .score import Score, score
 from .spec import Spec
@@ -122,8 +122,8 @@ def _check_filter(flt):
 
 def _start(flt, ds, truth, t0: float, start):
     if callable(getattr(flt, "start", None)):
-        i = int(np.searchsorted(truth.t, t0))
-        flt.start(TrueInitialState(float(truth.t[i]), truth.pos_ecef[i], truth.vel_enu[i], truth.quat_nb[i],
+        at = truth_at(truth, np.clip(t0, truth.t[0], truth.t[-1]))
+        flt.start(TrueInitialState(float(at.t[0]), at.pos_ecef[0], at.vel_enu[0], at.quat_nb[0],
                                    truth.lever_arm_b, *start))
 
 

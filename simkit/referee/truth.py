@@ -1,9 +1,5 @@
-"""The reference trajectory of a simkit file, and its value at any epoch inside its span.
-
-Position is interpolated in ECEF with cubic Hermite polynomials that use the truth velocity (rotated from ENU to
-ECEF at each sample), so the interpolation error is O(jerk dt^4): below 1 um at 100 Hz for 10 g manoeuvres;
-velocity is interpolated linearly (O(jerk dt^2 / 8), < 0.2 mm/s at 100 Hz and 10 m/s^3) and attitude by
-spherical linear interpolation of the body->ENU quaternions.
+"""The reference trajectory of a simkit file, and its value at any epoch inside its span
+(:func:`simkit.io.truth_at`: Hermite position, linear velocity, slerp attitude).
 
 A solution's point (:mod:`simkit.solution`) other than the IMU centre is scored against the truth moved along its
 body-frame lever arm l: position p + C_b^e l, Earth-relative velocity v + C_b^n (w_eb^b x l) (ENU at the point)
@@ -15,10 +11,9 @@ import numpy as np
 
 
 from .. import frames
-from ..io import TRUTH_CORE, Truth, has, open_dataset
+from ..io import TRUTH_CORE, Truth, has, open_dataset, truth_at  # noqa: F401 (truth_at: the referee's API)
 from ..io import read_truth as read_file_truth
 from ..solution import parse_point
-from . import quat
 from .errors import RefereeInputError
 
 
@@ -42,27 +37,6 @@ def overlap(truth: Truth, t: np.ndarray, where: str = "estimate") -> np.ndarray:
         raise RefereeInputError(where, f"estimate epochs ({span}) do not overlap the truth span "
                                        f"({truth.t[0]:.3f} .. {truth.t[-1]:.3f} s since the scenario start)")
     return inside
-
-
-def truth_at(truth: Truth, t: np.ndarray) -> Truth:
-    """The truth at epochs ``t`` (K,) s, all inside the truth span (see :func:`overlap`)."""
-    t = np.asarray(t, dtype=float)
-    i = np.clip(np.searchsorted(truth.t, t, side="right") - 1, 0, len(truth.t) - 2)
-    t0, t1 = truth.t[i], truth.t[i + 1]
-    h = t1 - t0
-    s = ((t - t0) / h)[:, None]
-    # ENU -> ECEF velocity at both end points, each in its own sample's geodetic frame
-    lat_lon = frames.ecef_to_lla(truth.pos_ecef[np.r_[i, i + 1]])[:, :2]
-    v_ecef = frames.enu_to_ecef_vec(truth.vel_enu[np.r_[i, i + 1]], lat_lon[:, 0], lat_lon[:, 1])
-    v0, v1 = v_ecef[: t.size], v_ecef[t.size:]
-    p0, p1 = truth.pos_ecef[i], truth.pos_ecef[i + 1]
-    h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
-    pos = h00 * p0 + h10 * h[:, None] * v0 + h01 * p1 + h11 * h[:, None] * v1
-    vel = (1 - s) * truth.vel_enu[i] + s * truth.vel_enu[i + 1]
-    q0, q1 = truth.quat_nb[i], truth.quat_nb[i + 1]
-    rel = quat.as_rotvec(quat.mul(quat.conj(q0), q1))          # slerp: q0 exp(s log(q0^-1 q1))
-    omega = None if truth.omega_ib_b is None else (1 - s) * truth.omega_ib_b[i] + s * truth.omega_ib_b[i + 1]
-    return Truth(t, pos, vel, quat.mul(q0, quat.from_rotvec(rel * s)), omega, truth.lever_arm_b)
 
 
 def point_lever(truth: Truth, point: str, where: str = "estimate") -> np.ndarray | None:

@@ -9,11 +9,11 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from .. import gpstime
 from ..constellation.geometry import lines_of_sight_enu
-from ..io import has, path_of, read_gnss, read_truth
+from ..io import has, path_of, read_gnss, read_truth, truth_at
 from .errors import ValidationInputError
 
 
@@ -97,9 +97,7 @@ def from_file(ds) -> ValidationGeometry:
     g = read_gnss(ds, signals=signals[:1], obs=("carrier",) if signals else (), truth=("antenna_pos_ecef",))
     t, rx = g.t, g.truth["antenna_pos_ecef"][:, 0, :]
     truth = read_truth(ds, fields=("quat_nb",), required=("quat_nb",))
-    tq, q = truth.t, truth.quat_nb
-    quat = Slerp(tq, Rotation.from_quat(q))(np.clip(t, tq[0], tq[-1])).as_quat() if len(tq) > 1 else \
-        np.broadcast_to(q[0], (len(t), 4))
+    quat = truth_at(truth, np.clip(t, truth.t[0], truth.t[-1])).quat_nb
     los, el = body_los(g.sat_pos_ecef, rx, quat)
     if signals:
         vis = np.isfinite(g.obs["carrier"][signals[0]]).all(axis=1)

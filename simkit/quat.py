@@ -39,3 +39,8 @@ def from_rotvec(v: np.ndarray) -> np.ndarray:
     half = 0.5 * angle
     scale = np.where(angle > 1e-8, np.sin(half) / np.where(angle > 1e-8, angle, 1.0), 0.5 - angle**2 / 48.0)
     return np.concatenate([v * scale[..., None], np.cos(half)[..., None]], axis=-1)
+
+
+def slerp(q0: np.ndarray, q1: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Spherical linear interpolation q0 exp(s log(q0^-1 q1)) of (K, 4) quaternion pairs at fractions s (K, 1)."""
+    return mul(q0, from_rotvec(as_rotvec(mul(conj(q0), q1)) * s))
