@@ -76,10 +76,10 @@ def split_params(filters: list[str], params: dict) -> dict:
 
 def _check_file(path, filters, shares) -> None:
     """The file opens as a simkit file, and each filter's values fit it (antenna index and count)."""
-    from .io import open_dataset
+    from .io import n_antennas, open_dataset
 
     with open_dataset(path) as ds:
-        n_ant = ds["gnss/antennas/lever_arm_b"].shape[0] if "gnss/antennas/lever_arm_b" in ds else 0
+        n_ant = n_antennas(ds)
     for name in filters:
         defaults = defaults_of(name)
         if defaults is not None:

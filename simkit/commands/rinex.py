@@ -20,12 +20,13 @@ def run(args) -> int:
     from ..errors import DataFileError
     from ..gnss.rinex import export
 
+    from ..io import has
     from ..io.output import check_name, check_output
 
     out = check_output(args.out, [args.file], option="-o", folder=True, parents=True)
     check_name("--name", args.name)
     with open_dataset(args.file) as ds:
-        if "gnss/t" not in ds:
+        if not has(ds, "gnss", "t"):
             raise DataFileError(args.file, "no /gnss group: the scenario has no [gnss] section")
         try:
             scenario = tomllib.loads(ds.attrs["scenario_toml"])
