@@ -24,6 +24,12 @@ def wrap(angle):
     return (angle + np.pi) % (2.0 * np.pi) - np.pi
 
 
+def wrap_2pi(angle):
+    """Angles (rad; a float or an array) wrapped to [0, 2 pi): headings and azimuths, clockwise from north.
+    Plain numpy, compiled as ``simkit.estimators.model.wrap_2pi`` for the kernels (as :func:`wrap`)."""
+    return angle % (2.0 * np.pi)
+
+
 def skew(v) -> np.ndarray:
     """[v x] (..., 3, 3) of vectors ``v`` (..., 3), any frame and unit: skew(v) @ x == cross(v, x). (The filter
     kernels use the compiled one-vector form ``simkit.estimators.nav.skew``.)"""
@@ -95,7 +101,7 @@ def euler_from_attitude(rot: Rotation) -> np.ndarray:
     with warnings.catch_warnings():  # gimbal lock at pitch = +-90 deg is a legitimate attitude (loops)
         warnings.simplefilter("ignore", UserWarning)
         yzr = rot.as_euler("ZXY")
-    heading = np.mod(-yzr[..., 0], 2.0 * np.pi)
+    heading = wrap_2pi(-yzr[..., 0])
     return np.stack([yzr[..., 1], yzr[..., 2], heading], axis=-1)
 
 

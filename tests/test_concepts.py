@@ -12,7 +12,7 @@ from simkit.estimators import model, nav
 PKG = Path(__file__).resolve().parents[1] / "simkit"
 
 # concept -> the modules allowed to define it; nav.skew is the compiled one-vector form the filter kernels call
-OWNERS = {"wrap": {"frames.py"}, "skew": {"frames.py", "estimators/nav.py"}, "euler_jacobian": {"frames.py"},
+OWNERS = {"wrap": {"frames.py"}, "wrap_2pi": {"frames.py"}, "skew": {"frames.py", "estimators/nav.py"}, "euler_jacobian": {"frames.py"},
           "sagnac_rotate": {"constellation/geometry.py"}, "dd_operator": {"gnss/differencing.py"},
           "dd_matrix": {"gnss/differencing.py"}, "spp": {"gnss/spp.py"}, "dd_float": {"gnss/differencing.py"},
           "symmetric": {"gnss/differencing.py"}, "systems_of": {"gnss/differencing.py"},

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..frames import euler_jacobian, skew
+from ..frames import euler_jacobian, skew, wrap_2pi
 from ..validation import atdop as validation_atdop
 
 
@@ -65,7 +65,7 @@ def single_baseline(b: np.ndarray, Qb: np.ndarray, f: np.ndarray):
     e, n, u = b[:, 0], b[:, 1], b[:, 2]
     h2 = e * e + n * n
     az_b, el_b = np.arctan2(f[0], f[1]), np.arctan2(f[2], np.hypot(f[0], f[1]))
-    heading = np.mod(np.arctan2(e, n) - az_b, 2 * np.pi)
+    heading = wrap_2pi(np.arctan2(e, n) - az_b)
     pitch = np.arctan2(u, np.sqrt(h2)) - el_b
     l2, h = h2 + u * u, np.sqrt(h2)
     J = np.zeros((len(b), 2, 3))

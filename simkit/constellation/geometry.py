@@ -129,7 +129,7 @@ def angles_from_enu(enu):
     """Elevation and azimuth (rad) of unit vectors ``enu`` (..., 3) in a local ENU frame; azimuth clockwise
     from north in [0, 2 pi)."""
     el = np.arcsin(np.clip(enu[..., 2], -1.0, 1.0))
-    az = np.mod(np.arctan2(enu[..., 0], enu[..., 1]), 2.0 * np.pi)
+    az = frames.wrap_2pi(np.arctan2(enu[..., 0], enu[..., 1]))
     return el, az
 
 

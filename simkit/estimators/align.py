@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..earth import OMEGA_E
+from ..frames import wrap_2pi
 from .errors import EstimatorInputError
 
 
@@ -31,7 +32,7 @@ def static_alignment(gyro, accel, lat, gyro_bias_sigma=0.0):
     c = np.vstack([east, north, up])  # rows: E, N, U in body axes -> C_b^n
     pitch = np.arcsin(np.clip(c[2, 1], -1, 1))
     roll = np.arctan2(-c[2, 0], c[2, 2])
-    heading = np.arctan2(c[0, 1], c[1, 1]) % (2 * np.pi)
+    heading = wrap_2pi(np.arctan2(c[0, 1], c[1, 1]))
     sigma = np.arctan2(gyro_bias_sigma, OMEGA_E * np.cos(lat))
     return np.array([pitch, roll, heading]), float(sigma)
 
@@ -42,4 +43,4 @@ def motion_alignment(vel_enu):
     horiz = np.hypot(v[0], v[1])
     if not horiz > 5.0:
         raise EstimatorInputError(f"motion alignment: horizontal speed {horiz:.2f} m/s, expected > 5 m/s")
-    return np.array([np.arctan2(v[2], horiz), 0.0, np.arctan2(v[0], v[1]) % (2 * np.pi)])
+    return np.array([np.arctan2(v[2], horiz), 0.0, wrap_2pi(np.arctan2(v[0], v[1]))])

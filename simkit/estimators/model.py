@@ -101,11 +101,12 @@ def euler(c):
     """[pitch, roll, heading] (rad) of C_b^n = R_z(-heading) R_x(pitch) R_y(roll); heading in [0, 2 pi)."""
     pitch = np.arcsin(min(1.0, max(-1.0, c[2, 1])))
     roll = np.arctan2(-c[2, 0], c[2, 2])
-    heading = np.arctan2(c[0, 1], c[1, 1]) % (2.0 * np.pi)
+    heading = wrap_2pi(np.arctan2(c[0, 1], c[1, 1]))
     return np.array([pitch, roll, heading])
 
 
 wrap = njit(cache=True)(frames.wrap)  # the compiled form of the one definition, for the filter kernels
+wrap_2pi = njit(cache=True)(frames.wrap_2pi)
 
 
 @njit(cache=True)

@@ -36,7 +36,7 @@ def quat_to_simkit(quat, frame: str = "enu-rfu", order: str = "xyzw", where: str
 
 def euler_from_rph(roll, pitch, heading) -> np.ndarray:
     """(K, 3) simkit Euler [pitch, roll, heading] (rad) from roll, pitch, heading (rad), in either convention."""
-    return np.stack([pitch, roll, np.mod(heading, 2 * np.pi)], axis=-1)
+    return np.stack([pitch, roll, frames.wrap_2pi(heading)], axis=-1)
 
 
 def position_ecef(lat=None, lon=None, h=None, ecef=None, where: str = "position") -> np.ndarray | None:
