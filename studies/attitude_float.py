@@ -16,7 +16,7 @@ from scipy.stats import binomtest
 from simkit.attitude.dd import float_solution
 from simkit.attitude.params import AMBIGUITY_DEFAULTS, merge
 from simkit.attitude.reading import read
-from simkit.attitude.resolve import resolve, subset
+from simkit.attitude.resolve import FixPolicy, resolve, subset
 from simkit.attitude.solvers import _wrong, body_baselines
 
 
@@ -35,7 +35,7 @@ def window_rates(fd, count: int, windows, every: int = 30, static: bool = False,
             if idx.size == 0:
                 continue
             sub = subset(grp, idx)
-            res = resolve(sub, "lambda", F, ratio_threshold=0.0, validation="none")
+            res = resolve(sub, "lambda", F, FixPolicy(ratio_threshold=0.0, validation="none"))
             bad, _ = _wrong(sub, res, fd)
             ok = res.accepted
             right += int((ok & ~bad).sum())

@@ -4,7 +4,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from simkit import ambiguity as amb
-from simkit.attitude import (AttitudeInputError, Observations, badshah_eq10, euler_atdop, float_solution,
+from simkit.attitude import (AttitudeInputError, FixPolicy, Observations, badshah_eq10, euler_atdop, float_solution,
                              phi_covariance, resolve, single_baseline, wahba_svd)
 from simkit.attitude.tdcp import tdcp_velocity
 from simkit.attitude.wahba import propagated_covariance, wahba_wls
@@ -114,7 +114,7 @@ def test_resolve_fixes_the_true_integers(method):
     R = attitude_from_euler(0.01, -0.02, 0.7).as_matrix()
     obs, N = _obs(rng, R, m=20)
     (grp,) = float_solution(obs)
-    res = resolve(grp, method, F, validation="ratio")  # the searches; validation pf: see the test below
+    res = resolve(grp, method, F, FixPolicy(validation="ratio"))  # the searches; validation pf: see the test below
     ref = differencing.reference_satellites(obs.elevation, np.ones(obs.elevation.shape, bool), obs.sat_ids)
     D, ant, sat = differencing.dd_operator(ref[0], np.ones(8, bool), 3)
     truth = (N.reshape(20, -1) @ D.T)[:, np.lexsort((sat, ant))]
@@ -185,7 +185,7 @@ def test_partial_fixing_fixes_true_integer_combinations_and_shrinks_the_baseline
     rng = np.random.default_rng(8)
     obs, N = _obs(rng, attitude_from_euler(0.0, 0.0, 0.4).as_matrix(), m=30, s=6, sig_phi=0.003, sig_p=0.2)
     (grp,) = float_solution(obs)
-    res = resolve(grp, "lambda", F, ratio_threshold=1e9, partial_p0=0.99)  # no full fix passes
+    res = resolve(grp, "lambda", F, FixPolicy(ratio_threshold=1e9, partial_p0=0.99))  # no full fix passes
     ref = differencing.reference_satellites(obs.elevation, np.ones(obs.elevation.shape, bool), obs.sat_ids)
     D, ant, sat = differencing.dd_operator(ref[0], np.ones(6, bool), 3)
     truth = (N.reshape(30, -1) @ D.T)[:, np.lexsort((sat, ant))]
@@ -318,7 +318,7 @@ def test_ffrt_validation_bounds_and_options():
     rng = np.random.default_rng(9)
     obs, _ = _obs(rng, attitude_from_euler(0.0, 0.0, 0.4).as_matrix(), m=8, s=5, sig_phi=0.003, sig_p=0.3)
     (grp,) = float_solution(obs)
-    res = resolve(grp, "lambda", F, validation="ffrt", pf=0.01, ffrt_samples=2000)
+    res = resolve(grp, "lambda", F, FixPolicy(validation="ffrt", pf=0.01, ffrt_samples=2000))
     assert np.all(res.sr_bounds[:, 0] <= res.sr_bounds[:, 1] + 1e-12)
     assert np.all(res.sr_bounds[:, 0] >= res.success_rate - 1e-12)
     assert np.all((res.mu > 0) & (res.mu <= 1))
@@ -327,12 +327,12 @@ def test_ffrt_validation_bounds_and_options():
     mu = amb.ffrt_thresholds(grp.Qa[need], 0.01, 2000, seed=len(grp.Qa))
     assert np.array_equal(res.mu[need], mu)
     assert np.array_equal(res.accepted, res.finished & (1.0 / res.ratio <= res.mu))
-    none = resolve(grp, "lambda", F, validation="none")
+    none = resolve(grp, "lambda", F, FixPolicy(validation="none"))
     assert none.accepted.all() and np.isnan(none.mu).all()
     with pytest.raises(AttitudeInputError, match="estimator.validation"):
-        resolve(grp, "clambda", F, validation="ffrt")
+        resolve(grp, "clambda", F, FixPolicy(validation="ffrt"))
     with pytest.raises(AttitudeInputError, match="estimator.validation"):
-        resolve(grp, "lambda", F, validation="strict")
+        resolve(grp, "lambda", F, FixPolicy(validation="strict"))
 
 
 @pytest.mark.parametrize("method", ["lambda", "clambda", "mclambda"])
@@ -343,9 +343,9 @@ def test_pf_validation_accepts_only_ratio_passes_whose_ils_failure_rate_is_held(
     rng = np.random.default_rng(12)
     obs, _ = _obs(rng, attitude_from_euler(0.0, 0.0, 0.4).as_matrix(), m=30, s=7, sig_phi=0.003, sig_p=0.2)
     (grp,) = float_solution(obs)
-    kw = dict(pf=0.01, ffrt_samples=2000)
-    res = resolve(grp, method, F, **kw)
-    own = resolve(grp, method, F, validation="ratio")
+    policy = FixPolicy(pf=0.01, ffrt_samples=2000)
+    res = resolve(grp, method, F, policy)
+    own = resolve(grp, method, F, FixPolicy(validation="ratio"))
     ils = amb.ils_batch(grp.a_hat, grp.Qa, n_cands=2)
     best_2nd = ils.sqnorms[:, 0] / ils.sqnorms[:, 1]
     same = np.all(ils.candidates[:, 0] == np.nan_to_num(own.z, nan=0.5), axis=1) & (best_2nd <= 1 / 3)
@@ -353,4 +353,4 @@ def test_pf_validation_accepts_only_ratio_passes_whose_ils_failure_rate_is_held(
     assert np.array_equal(res.accepted, own.accepted & same & held) and res.accepted.any()
     assert np.array_equal(np.isfinite(res.mu), own.accepted & same)  # calibrated only where needed
     assert method == "lambda" or (own.accepted & ~res.accepted).any()  # constrained ratio passes rejected here
-    assert np.array_equal(resolve(grp, method, F, **kw).accepted, res.accepted)  # deterministic
+    assert np.array_equal(resolve(grp, method, F, policy).accepted, res.accepted)  # deterministic

@@ -6,7 +6,7 @@ See docs/attitude.md.
 """
 from .dd import FloatGroup, Observations, float_solution
 from .errors import AttitudeInputError
-from .resolve import METHODS, Resolution, resolve
+from .resolve import METHODS, FixPolicy, Resolution, resolve
 from .solvers import build_registry
 from .tight import FixedDD, fixed_dd, read_fixed_dd
 from .velocity import solve_tdcp
@@ -14,6 +14,6 @@ from .wahba import badshah_eq10, euler_atdop, euler_covariance, phi_covariance, 
 
 SOLVERS = {**build_registry(), "tdcp": solve_tdcp}
 
-__all__ = ["AttitudeInputError", "FixedDD", "FloatGroup", "METHODS", "Observations", "Resolution", "SOLVERS",
+__all__ = ["AttitudeInputError", "FixPolicy", "FixedDD", "FloatGroup", "METHODS", "Observations", "Resolution", "SOLVERS",
            "badshah_eq10", "euler_atdop", "euler_covariance", "fixed_dd", "float_solution", "phi_covariance",
            "read_fixed_dd", "resolve", "single_baseline", "wahba_svd"]

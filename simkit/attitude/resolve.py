@@ -19,6 +19,24 @@ VALIDATIONS = ("pf", "ratio", "ffrt", "none")
 
 
 @dataclass(frozen=True)
+class FixPolicy:
+    """How fixes are searched and accepted. ``validation`` "pf": the ratio test, then only where the failure rate
+    is proven <= ``pf`` (:func:`_hold_pf`); "ratio": accept when ratio >= ``ratio_threshold`` (0 accepts every
+    finished search); "none": accept every finished search; "ffrt" (LAMBDA only): fixed-failure-rate ratio test,
+    accept when best / 2nd <= mu with mu calibrated per epoch on its own Qa for the failure rate ``pf``
+    (``ffrt_samples`` Monte Carlo draws; mu = 1 without draws where the lower bound of the ILS success rate is
+    already >= 1 - pf). ``partial_p0`` (LAMBDA only): epochs that fail the test fix the largest decorrelated
+    subset whose bootstrapped success rate is >= partial_p0. ``max_nodes``: the search's work cap."""
+
+    ratio_threshold: float = 3.0
+    partial_p0: float | None = None
+    max_nodes: int = amb.DEFAULT_MAX_NODES
+    validation: str = "pf"
+    pf: float = 1e-3
+    ffrt_samples: int = 10_000
+
+
+@dataclass(frozen=True)
 class Resolution:
     """Per epoch of a group (K epochs, r baselines, n channels per baseline).
 
@@ -86,19 +104,10 @@ def _search(grp: FloatGroup, method: str, F: np.ndarray, max_nodes: int, stop: f
     return res.candidates[:, 0], res.costs[:, 1] / res.costs[:, 0], res.finished, res.rotations[:, 0], res.bounded
 
 
-def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float = 3.0, partial_p0=None,
-            max_nodes: int = amb.DEFAULT_MAX_NODES, validation: str = "pf", pf: float = 1e-3,
-            ffrt_samples: int = 10_000) -> Resolution:
-    """Fix the ambiguities of ``grp`` with ``method`` (one of :data:`METHODS`); ``F`` (3, r) body baselines m.
-
-    ``validation`` "pf": the ratio test, then only where the failure rate is proven <= ``pf`` (:func:`_hold_pf`);
-    "ratio": accept when ratio >= ``ratio_threshold`` (0 accepts every finished search); "none":
-    accept every finished search; "ffrt" (LAMBDA only): fixed-failure-rate ratio test, accept when best / 2nd <=
-    mu with mu calibrated per epoch on its own Qa for the failure rate ``pf`` (``ffrt_samples`` Monte Carlo
-    draws; mu = 1 without draws where the lower bound of the ILS success rate is already >= 1 - pf). With
-    ``partial_p0`` (LAMBDA only) epochs that fail the test fix the largest decorrelated subset whose
-    bootstrapped success rate is >= partial_p0.
-    """
+def resolve(grp: FloatGroup, method: str, F: np.ndarray, policy: FixPolicy = FixPolicy()) -> Resolution:
+    """Fix the ambiguities of ``grp`` with ``method`` (one of :data:`METHODS`) under ``policy``; ``F`` (3, r)
+    body baselines m."""
+    validation, ratio_threshold, pf = policy.validation, policy.ratio_threshold, policy.pf
     if method not in METHODS:
         raise AttitudeInputError("method", f"{method!r}; expected one of {', '.join(METHODS)}")
     if validation not in VALIDATIONS or (validation == "ffrt" and method != "lambda"):
@@ -108,17 +117,16 @@ def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float 
         ratio_threshold = 0.0
     stop = ratio_threshold if ratio_threshold > 0 and validation in ("ratio", "pf") else 1.0  # 1: stop once best is proven
     with np.errstate(divide="ignore", invalid="ignore"):  # an unfinished search has no 2nd cost: ratio NaN / inf
-        z, ratio, finished, rot, bounded = _search(grp, method, np.asarray(F, float), max_nodes, stop)
+        z, ratio, finished, rot, bounded = _search(grp, method, np.asarray(F, float), policy.max_nodes, stop)
     sr, bounds = _success_rates(grp.Qa)
     mu = np.full(len(z), np.nan)
     if validation == "ffrt":
-        mu = _ffrt_mu(grp.Qa, bounds[:, 0], pf, ffrt_samples)
+        mu = _ffrt_mu(grp.Qa, bounds[:, 0], pf, policy.ffrt_samples)
         accepted = finished & (1.0 / ratio <= mu)
     else:
         accepted = finished & ((ratio >= ratio_threshold) | (ratio_threshold <= 0))
         if validation == "pf":
-            accepted, mu = _hold_pf(grp, method, z, ratio, accepted, bounds[:, 0], pf, ffrt_samples, max_nodes,
-                                    ratio_threshold)
+            accepted, mu = _hold_pf(grp, method, z, ratio, accepted, bounds[:, 0], policy)
     b, Qb = conditioned(grp, z.astype(float))
     b = np.where(accepted[:, None], b, grp.b_hat)
     Qb = np.where(accepted[:, None, None], Qb, grp.Qb)
@@ -127,8 +135,9 @@ def resolve(grp: FloatGroup, method: str, F: np.ndarray, ratio_threshold: float 
     z_check = [z[i] if accepted[i] else z[i, :0] for i in range(len(z))]
     Zs = [eye if accepted[i] else eye[:, :0] for i in range(len(z))]
     partial = np.zeros(len(z), bool)
-    if partial_p0 is not None and method == "lambda":
-        _partial(grp, partial_p0, accepted, partial, b, Qb, z_check, Zs)
+    if policy.partial_p0 is not None and method == "lambda":
+        for i, (bi, Qbi, zi, Zi) in _partial(grp, policy.partial_p0, accepted):
+            b[i], Qb[i], z_check[i], Zs[i], partial[i] = bi, Qbi, zi, Zi, True
     return Resolution(zf, ratio, accepted, partial, sr, finished, b, Qb, rot, z_check, Zs, bounded, bounds, mu)
 
 
@@ -142,7 +151,7 @@ def _ffrt_mu(Qa, lower, pf, n_samples):
     return mu
 
 
-def _hold_pf(grp, method, z, ratio, passed, lower, pf, n_samples, max_nodes, threshold):
+def _hold_pf(grp, method, z, ratio, passed, lower, policy):
     """(accepted (K,), mu (K,)) of validation "pf": of the epochs that ``passed`` the method's own ratio test, keep
     those whose ILS failure rate is proven <= ``pf``, by the lower bound ``lower`` (K,) of the ILS success rate
     (mu = 1) or else by the fixed-failure-rate test on the ILS ratio (mu calibrated on the epoch's Qa, only for
@@ -150,6 +159,7 @@ def _hold_pf(grp, method, z, ratio, passed, lower, pf, n_samples, max_nodes, thr
     ratio passes ``threshold`` too: then it is wrong only where ILS is, so P(wrong and accepted) <= P(ILS wrong and
     accepted) <= pf for all three methods, and no more epochs are calibrated than for LAMBDA. The decision reads
     the float solution only (never the truth)."""
+    pf, n_samples, threshold = policy.pf, policy.ffrt_samples, policy.ratio_threshold
     mu, accepted = np.full(len(z), np.nan), np.zeros(len(z), bool)
     idx = np.flatnonzero(passed)
     if idx.size == 0:
@@ -157,7 +167,7 @@ def _hold_pf(grp, method, z, ratio, passed, lower, pf, n_samples, max_nodes, thr
     if method == "lambda":
         same, best_over_2nd = np.ones(idx.size, bool), 1.0 / ratio[idx]
     else:
-        ils = amb.ils_batch(grp.a_hat[idx], grp.Qa[idx], n_cands=2, max_nodes=max_nodes)
+        ils = amb.ils_batch(grp.a_hat[idx], grp.Qa[idx], n_cands=2, max_nodes=policy.max_nodes)
         with np.errstate(divide="ignore", invalid="ignore"):
             best_over_2nd = ils.sqnorms[:, 0] / ils.sqnorms[:, 1]
         same = ils.finished & np.all(ils.candidates[:, 0] == z[idx], axis=1) & (best_over_2nd * threshold <= 1)
@@ -173,8 +183,9 @@ def _success_rates(Qa: np.ndarray):
     return b["bootstrap"], np.stack([b["lower"], b["upper"]], axis=-1)
 
 
-def _partial(grp, p0, accepted, partial, b, Qb, z_check, Zs):
-    """Partial fixes of the rejected epochs, in place (baselines conditioned on the fixed combinations)."""
+def _partial(grp, p0, accepted):
+    """Partial fixes of the rejected epochs: yields (epoch, (baseline conditioned on the fixed combinations,
+    its covariance, the fixed combinations, their integer map))."""
     for i in np.flatnonzero(~accepted):
         pf = amb.partial_fix(grp.a_hat[i], grp.Qa[i], p0=p0)
         if pf.n_fixed == 0:
@@ -182,10 +193,8 @@ def _partial(grp, p0, accepted, partial, b, Qb, z_check, Zs):
         Z = pf.Z_fixed.astype(float)
         Qz = Z.T @ grp.Qa[i] @ Z
         K = grp.Qba[i] @ Z @ np.linalg.inv(Qz)
-        b[i] = grp.b_hat[i] - K @ (Z.T @ grp.a_hat[i] - pf.z_fixed)
-        Qb[i] = grp.Qb[i] - K @ Z.T @ grp.Qba[i].T
-        partial[i] = True
-        z_check[i], Zs[i] = pf.z_fixed, pf.Z_fixed
+        yield i, (grp.b_hat[i] - K @ (Z.T @ grp.a_hat[i] - pf.z_fixed), grp.Qb[i] - K @ Z.T @ grp.Qba[i].T,
+                  pf.z_fixed, pf.Z_fixed)
 
 
 def subset(grp: FloatGroup, idx: np.ndarray) -> FloatGroup:
@@ -195,7 +204,7 @@ def subset(grp: FloatGroup, idx: np.ndarray) -> FloatGroup:
                       None if grp.Qphi_correlated is None else grp.Qphi_correlated[idx])
 
 
-def _first_fixes(grp, breaks, method, F, kw):
+def _first_fixes(grp, breaks, method, F, policy):
     """Search run by run (a run: epochs between continuity breaks) until each run has an accepted fix; chunks
     double (1, 2, 4, ... epochs per run) so a run that never fixes costs O(log) calls. Returns (searched
     {epoch: (Resolution, row)}, first accepted epoch per run or -1, run id per epoch)."""
@@ -206,7 +215,7 @@ def _first_fixes(grp, breaks, method, F, kw):
     pending = np.arange(len(starts))
     while pending.size:
         idx = np.concatenate([np.arange(pos[q], min(pos[q] + step, ends[q])) for q in pending])
-        res = resolve(subset(grp, idx), method, F, **kw)
+        res = resolve(subset(grp, idx), method, F, policy)
         for row, i in enumerate(idx):
             searched[i] = (res, row)
         acc = idx[res.accepted]
@@ -219,11 +228,12 @@ def _first_fixes(grp, breaks, method, F, kw):
     return searched, first, run
 
 
-def resolve_held(grp: FloatGroup, method: str, F: np.ndarray, breaks: np.ndarray, **kw) -> Resolution:
+def resolve_held(grp: FloatGroup, method: str, F: np.ndarray, breaks: np.ndarray,
+                 policy: FixPolicy = FixPolicy()) -> Resolution:
     """:func:`resolve` with ambiguity continuity: after the first accepted fix of a run of epochs without a
     break (``breaks`` (K,) bool: a gap in the epochs or a loss-of-lock flag on any channel used), the later
     epochs of the run keep that fix (their ``ratio`` is NaN: not searched). Epochs before it are searched."""
-    searched, first, run = _first_fixes(grp, np.asarray(breaks, bool), method, F, kw)
+    searched, first, run = _first_fixes(grp, np.asarray(breaks, bool), method, F, policy)
     K = len(run)
     fields = {f: [] for f in ("z", "ratio", "accepted", "partial", "finished", "rotation", "bounded", "mu")}
     z_check, Zs, b, Qb = [None] * K, [None] * K, grp.b_hat.copy(), grp.Qb.copy()

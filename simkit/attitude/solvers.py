@@ -12,7 +12,7 @@ from .dd import FloatGroup, float_solution, run_breaks
 from .errors import AttitudeInputError
 from .params import AMBIGUITY_DEFAULTS, merge
 from .reading import FileData, read
-from .resolve import Resolution, resolve, resolve_held
+from .resolve import FixPolicy, Resolution, resolve, resolve_held
 
 STATUS = {"none": -1, "float": 0, "fixed": 1, "partial": 2, "wrong fix": 3}
 _METHOD = {"attitude": "lambda", "attitude_c": "clambda", "attitude_mc": "mclambda"}
@@ -111,12 +111,12 @@ def _store(out: dict, grp: FloatGroup, res: Resolution, fd: FileData, R, cov):
     out["sigma_dd_carrier"][e] = np.sqrt(np.mean(np.diagonal(grp.Qphi, axis1=1, axis2=2), axis=1))
 
 
-def resolve_options(p: dict, partial: bool = True) -> dict:
-    """The keyword arguments of :func:`resolve` from the merged ambiguity parameters ``p`` (validation, its
-    threshold, pf and draws, the work cap; partial fixing unless ``partial`` is False)."""
-    return dict(ratio_threshold=p["ratio_threshold"], partial_p0=(p["partial_p0"] or None) if partial else None,
-                max_nodes=int(p["max_nodes"]), validation=p["validation"], pf=p["pf"],
-                ffrt_samples=int(p["ffrt_samples"]))
+def resolve_options(p: dict, partial: bool = True) -> FixPolicy:
+    """The :class:`FixPolicy` of the merged ambiguity parameters ``p`` (validation, its threshold, pf and draws,
+    the work cap; partial fixing unless ``partial`` is False)."""
+    return FixPolicy(ratio_threshold=p["ratio_threshold"], partial_p0=(p["partial_p0"] or None) if partial else None,
+                     max_nodes=int(p["max_nodes"]), validation=p["validation"], pf=p["pf"],
+                     ffrt_samples=int(p["ffrt_samples"]))
 
 
 def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> tuple[dict, tuple]:
@@ -129,11 +129,11 @@ def solve_arrays(fd: FileData, method: str, p: dict, progress: bool = False) -> 
     groups = float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None, p["float_epochs"],
                             bool(p["static"]), fd.lli)
     for grp in _progress(groups, progress, f"attitude ({method})"):
-        kw = resolve_options(p)
+        policy = resolve_options(p)
         if p["continuity"] and p["every"] == 1:
-            res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), **kw)
+            res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), policy)
         else:
-            res = resolve(grp, method, F, **kw)
+            res = resolve(grp, method, F, policy)
         R, cov, _ = _attitude(res, F, method, p["attitude"])
         _store(out, grp, res, fd, R, cov)
         if not single:

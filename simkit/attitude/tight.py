@@ -106,16 +106,16 @@ def fixed_dd(fd: FileData, method: str, p: dict, correlation_s: float = 0.0, win
     if method not in METHODS:
         raise AttitudeInputError("method", f"{method!r}; expected one of {', '.join(METHODS)}")
     F = body_baselines(fd.lever_arm)
-    kw = resolve_options(p, partial=False)
+    policy = resolve_options(p, partial=False)
     rows = []
     interval = float(np.median(np.diff(fd.t))) if len(fd.t) > 1 else 1.0
     inflation = correlation_inflation(correlation_s, interval, window)
     for grp in float_solution(fd.obs, np.radians(p["mask_deg"]), p["max_sats"] or None, p["float_epochs"],
                               bool(p["static"]), fd.lli, correlated=inflation != 1.0):
         if p["continuity"] and p["every"] == 1:
-            res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), **kw)
+            res = resolve_held(grp, method, F, continuity_breaks(grp, fd.lli), policy)
         else:
-            res = resolve(grp, method, F, **kw)
+            res = resolve(grp, method, F, policy)
         rows += group_rows(fd, grp, res, F, inflation)
     rows.sort(key=lambda row: row[0])
     return _pack(fd, rows)
