@@ -17,8 +17,8 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, force=Fal
 
 
 def open(path):  # noqa: A001 - the documented API name
-    """Open a simkit HDF5 file lazily (see :class:`simkit.io.reader.Dataset`)."""
-    from .io.reader import open_dataset
+    """Open a simkit HDF5 file lazily (see :class:`simkit.io.dataset.Dataset`)."""
+    from .io.dataset import open_dataset
 
     return open_dataset(path)
 

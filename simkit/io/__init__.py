@@ -1,8 +1,9 @@
 """HDF5 input/output, the only stage that knows HDF5: the schema (:mod:`.schema`), the block writer, the lazy
-reader, and the checks on an output path."""
+file object (:mod:`.dataset`), the typed readers the consumers use (:mod:`.readers`: truth, IMU, GNSS, the truth
+at any epoch) and the checks on an output path."""
 from .campaign_index import write_campaign_index
 from .output import check_output
-from .reader import Array, Dataset, open_dataset
+from .dataset import Array, Dataset, open_dataset
 from .readers import (TRUTH_CORE, Gnss, Imu, Truth, broadcast_ionosphere, gnss_signals, has, members, n_antennas,
                       n_samples, path_of, read_gnss, read_imu, read_truth, truth_at, truth_rows)
 from .schema import SCHEMA, SCHEMA_VERSION, Field, SchemaError, field

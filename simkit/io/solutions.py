@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import DataFileError
 from ..solution import Solution, parse_point
 from . import schema
-from .reader import open_dataset
+from .dataset import open_dataset
 
 _NAME = re.compile(r"^[A-Za-z0-9_.-]+$")
 _FIELDS = ("t", "pos_ecef", "vel_enu", "quat_nb", "euler", "cov")
