@@ -12,7 +12,7 @@ from simkit.attitude import read_fixed_dd
 from simkit.attitude.dd import float_solution
 from simkit.attitude.params import AMBIGUITY_DEFAULTS
 from simkit.attitude.reading import read
-from simkit.attitude.resolve import resolve
+from simkit.attitude.resolve import FixPolicy, resolve
 from simkit.attitude.solvers import body_baselines
 from simkit.attitude.tight import group_rows
 from simkit.estimators import DDCarrier, EstimatorInputError, SOLVERS, model, nav
@@ -110,7 +110,7 @@ def test_lli_flags_and_rejected_fixes_keep_rows_out(xian):
     assert len(row[3]) == F.shape[1] * len(grp.sat) - 1 and row[6] == 1
     fd.lli[grp.signal[0], e0, 0, grp.ref[0]] = 1  # the reference on antenna 0: every row of the epoch goes
     assert all(r[0] != e0 for r in group_rows(fd, grp, res, F))
-    rejected = resolve(grp, "lambda", F, ratio_threshold=1e9)  # nothing passes validation: nothing enters
+    rejected = resolve(grp, "lambda", F, FixPolicy(ratio_threshold=1e9))  # nothing passes validation: nothing enters
     assert group_rows(fd, grp, rejected, F) == []
 
 
