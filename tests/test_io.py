@@ -169,6 +169,7 @@ LAYERS = [
     {"trajectory", "imu", "constellation"},
     {"gnss"},
     {"io"},
+    {"logs"},
     {"scenario"},
     {"pipeline"},
     {"validation"},

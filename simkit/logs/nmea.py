@@ -1,0 +1,134 @@
+"""NMEA 0183 logs: GGA (position, time of day), RMC (date, horizontal velocity), VTG (horizontal velocity),
+GST (position standard deviations); any talker (GP, GN, GL, GA, BD, GB). Other sentences are skipped.
+
+A small parser of our own rather than ``pynmea2``: the four sentences are a few fields each, and reading them
+here gives one error naming the line for a bad checksum or field, which is what a log replay needs.
+
+Epochs are keyed by the UTC time-of-day field; a VTG belongs to the epoch of the sentence before it. The date is
+RMC's; a log without RMC takes the date of ``scenario.start`` and rolls over at midnight. GGA quality 0 (no fix)
+is skipped. Height = antenna altitude above the geoid + geoid separation (both in GGA): ellipsoidal.
+"""
+from __future__ import annotations
+
+from datetime import date, datetime, timezone
+
+import numpy as np
+
+from .. import frames
+from ..errors import DataFileError
+from .record import Record, utc_to_gps_arrays
+
+KNOT = 1852.0 / 3600.0
+
+
+def _checksum(body: str) -> int:
+    c = 0
+    for ch in body.encode("ascii", "replace"):
+        c ^= ch
+    return c
+
+
+def _angle(value: str, hemi: str, width: int) -> float:
+    deg = float(value[:width]) + float(value[width:]) / 60.0
+    return -deg if hemi in ("S", "W") else deg
+
+
+def _tod(value: str) -> float:
+    return int(value[0:2]) * 3600.0 + int(value[2:4]) * 60.0 + float(value[4:])
+
+
+def read(path, date_hint: date | None = None) -> Record:
+    """The GGA fixes of an NMEA file, with RMC/VTG velocity and GST sigmas where present."""
+    src = str(path)
+    epochs: dict[float, dict] = {}
+    order: list[float] = []
+    current = None
+    day_of = {}
+    try:
+        text = open(path, encoding="ascii", errors="replace").read()
+    except OSError as exc:
+        raise DataFileError(src, f"cannot read: {exc}") from None
+    for n, raw in enumerate(text.splitlines(), 1):
+        line = raw.strip()
+        if not line:
+            continue
+        if not line.startswith("$"):
+            raise DataFileError(src, f"expected an NMEA sentence starting with '$', got {line[:20]!r}", n)
+        body, star, check = line[1:].partition("*")
+        if star:
+            try:
+                ok = int(check[:2], 16) == _checksum(body)
+            except ValueError:
+                ok = False
+            if not ok:
+                raise DataFileError(src, f"bad checksum *{check} (computed *{_checksum(body):02X})", n)
+        f = body.split(",")
+        kind = f[0][-3:]
+        try:
+            if kind == "GGA":
+                if len(f) < 12:
+                    raise ValueError("GGA needs 14 fields")
+                if not f[1] or not f[6] or int(f[6]) == 0 or not f[2]:
+                    continue
+                if not f[9] or not f[11]:
+                    raise ValueError("altitude or geoid separation empty: the ellipsoidal height is unknown")
+                tod = _tod(f[1])
+                e = epochs.setdefault(tod, {})
+                if tod not in order:
+                    order.append(tod)
+                e.update(lat=_angle(f[2], f[3], 2), lon=_angle(f[4], f[5], 3), h=float(f[9]) + float(f[11]),
+                         line=n)
+                current = tod
+            elif kind == "RMC":
+                if len(f) < 10:
+                    raise ValueError("RMC needs at least 10 fields")
+                if not f[1]:
+                    continue
+                tod = _tod(f[1])
+                current = tod
+                if f[9]:
+                    day_of[tod] = date(2000 + int(f[9][4:6]), int(f[9][2:4]), int(f[9][0:2]))
+                if f[2] == "A" and f[7] and f[8]:
+                    _velocity(epochs.setdefault(tod, {}), float(f[7]) * KNOT, float(f[8]))
+            elif kind == "VTG":
+                if current is not None and len(f) > 7 and f[1] and f[7]:
+                    _velocity(epochs.setdefault(current, {}), float(f[7]) / 3.6, float(f[1]))
+            elif kind == "GST":
+                if len(f) < 9:
+                    raise ValueError("GST needs 9 fields")
+                if f[1] and f[6] and f[7] and f[8]:
+                    tod = _tod(f[1])
+                    epochs.setdefault(tod, {})["sigma"] = (float(f[7]), float(f[6]), float(f[8]))
+        except (ValueError, IndexError) as exc:
+            raise DataFileError(src, f"malformed {kind} sentence: {exc}", n) from None
+    fixes = [tod for tod in order if "lat" in epochs[tod]]
+    if not fixes:
+        raise DataFileError(src, "no GGA fix (quality > 0) found: NMEA logs need GGA for positions and heights")
+    if not day_of and date_hint is None:
+        raise DataFileError(src, "no RMC date and no date given: set scenario.start")
+    days, day, last = [], None, None
+    for tod in fixes:
+        if tod in day_of:
+            day = day_of[tod]
+        elif day is None:
+            day = next(iter(day_of.values())) if day_of else date_hint
+        elif last is not None and tod < last - 43200.0:         # midnight without an RMC date
+            day = date.fromordinal(day.toordinal() + 1)
+        days.append(day)
+        last = tod
+    ns = np.array([int(datetime(d.year, d.month, d.day, tzinfo=timezone.utc).timestamp()) * 10**9
+                   + int(round(tod * 1e9)) for d, tod in zip(days, fixes)], dtype=np.int64)
+    week, sow = utc_to_gps_arrays(ns)
+    ep = [epochs[t] for t in fixes]
+    lat, lon, h = (np.radians([e["lat"] for e in ep]), np.radians([e["lon"] for e in ep]),
+                   np.array([e["h"] for e in ep]))
+    vel = np.array([e.get("vel", (np.nan, np.nan, np.nan)) for e in ep])
+    sig = np.array([e.get("sigma", (np.nan, np.nan, np.nan)) for e in ep])
+    return Record(week, sow, frames.lla_to_ecef(lat, lon, h), np.array([e["line"] for e in ep]), src,
+                  sigma_enu=sig if np.isfinite(sig).all() else None,
+                  vel_enu=vel if np.isfinite(vel).any() else None)
+
+
+def _velocity(epoch: dict, speed: float, course_deg: float) -> None:
+    c = np.radians(course_deg)
+    epoch["vel"] = (speed * np.sin(c), speed * np.cos(c), np.nan)
