@@ -4,7 +4,8 @@ GST (position standard deviations); any talker (GP, GN, GL, GA, BD, GB). Other s
 A small parser of our own rather than ``pynmea2``: the four sentences are a few fields each, and reading them
 here gives one error naming the line for a bad checksum or field, which is what a log replay needs.
 
-Epochs are keyed by the UTC time-of-day field; a VTG belongs to the epoch of the sentence before it. The date is
+Each GGA with a fix is one sample; an RMC or GST joins the GGA of the same UTC time of day (before or after it),
+a VTG the epoch of the time-bearing sentence before it. The date is
 RMC's; a log without RMC takes the date of ``scenario.start`` and rolls over at midnight. GGA quality 0 (no fix)
 is skipped. Height = antenna altitude above the geoid + geoid separation (both in GGA): ellipsoidal.
 """
@@ -40,14 +41,19 @@ def _tod(value: str) -> float:
 def read(path, date_hint: date | None = None) -> Record:
     """The GGA fixes of an NMEA file, with RMC/VTG velocity and GST sigmas where present."""
     src = str(path)
-    epochs: dict[float, dict] = {}
-    order: list[float] = []
-    current = None
-    day_of = {}
+    fixes: list[dict] = []           # one per GGA, in file order
+    pending: dict[float, dict] = {}  # RMC / GST / VTG data that came before the GGA of their epoch
+    current = None                   # time of day of the last time-bearing sentence (VTG has none)
     try:
         text = open(path, encoding="ascii", errors="replace").read()
     except OSError as exc:
         raise DataFileError(src, f"cannot read: {exc}") from None
+
+    def epoch(tod):
+        if fixes and fixes[-1]["tod"] == tod:
+            return fixes[-1]
+        return pending.setdefault(tod, {})
+
     for n, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         if not line:
@@ -68,63 +74,59 @@ def read(path, date_hint: date | None = None) -> Record:
             if kind == "GGA":
                 if len(f) < 12:
                     raise ValueError("GGA needs 14 fields")
-                if not f[1] or not f[6] or int(f[6]) == 0 or not f[2]:
+                if not f[1]:
+                    continue
+                current = tod = _tod(f[1])
+                if not f[6] or int(f[6]) == 0 or not f[2]:
                     continue
                 if not f[9] or not f[11]:
                     raise ValueError("altitude or geoid separation empty: the ellipsoidal height is unknown")
-                tod = _tod(f[1])
-                e = epochs.setdefault(tod, {})
-                if tod not in order:
-                    order.append(tod)
-                e.update(lat=_angle(f[2], f[3], 2), lon=_angle(f[4], f[5], 3), h=float(f[9]) + float(f[11]),
-                         line=n)
-                current = tod
+                fix = dict(pending.pop(tod, {}), tod=tod, lat=_angle(f[2], f[3], 2), lon=_angle(f[4], f[5], 3),
+                           h=float(f[9]) + float(f[11]), line=n)
+                fixes.append(fix)
             elif kind == "RMC":
                 if len(f) < 10:
                     raise ValueError("RMC needs at least 10 fields")
                 if not f[1]:
                     continue
-                tod = _tod(f[1])
-                current = tod
+                current = tod = _tod(f[1])
+                e = epoch(tod)
                 if f[9]:
-                    day_of[tod] = date(2000 + int(f[9][4:6]), int(f[9][2:4]), int(f[9][0:2]))
+                    yy = int(f[9][4:6])      # two digits: 80-99 are 1980-1999 (GPS began in 1980)
+                    e["day"] = date((1900 if yy >= 80 else 2000) + yy, int(f[9][2:4]), int(f[9][0:2]))
                 if f[2] == "A" and f[7] and f[8]:
-                    _velocity(epochs.setdefault(tod, {}), float(f[7]) * KNOT, float(f[8]))
+                    _velocity(e, float(f[7]) * KNOT, float(f[8]))
             elif kind == "VTG":
                 if current is not None and len(f) > 7 and f[1] and f[7]:
-                    _velocity(epochs.setdefault(current, {}), float(f[7]) / 3.6, float(f[1]))
+                    _velocity(epoch(current), float(f[7]) / 3.6, float(f[1]))
             elif kind == "GST":
                 if len(f) < 9:
                     raise ValueError("GST needs 9 fields")
                 if f[1] and f[6] and f[7] and f[8]:
-                    tod = _tod(f[1])
-                    epochs.setdefault(tod, {})["sigma"] = (float(f[7]), float(f[6]), float(f[8]))
+                    current = tod = _tod(f[1])
+                    epoch(tod)["sigma"] = (float(f[7]), float(f[6]), float(f[8]))
         except (ValueError, IndexError) as exc:
             raise DataFileError(src, f"malformed {kind} sentence: {exc}", n) from None
-    fixes = [tod for tod in order if "lat" in epochs[tod]]
     if not fixes:
         raise DataFileError(src, "no GGA fix (quality > 0) found: NMEA logs need GGA for positions and heights")
-    if not day_of and date_hint is None:
+    dated = [e["day"] for e in fixes if "day" in e]
+    if not dated and date_hint is None:
         raise DataFileError(src, "no RMC date and no date given: set scenario.start")
-    days, day, last = [], None, None
-    for tod in fixes:
-        if tod in day_of:
-            day = day_of[tod]
-        elif day is None:
-            day = next(iter(day_of.values())) if day_of else date_hint
-        elif last is not None and tod < last - 43200.0:         # midnight without an RMC date
+    day, last, ns = (dated[0] if dated else date_hint), None, []
+    for e in fixes:
+        if "day" in e:
+            day = e["day"]
+        elif last is not None and e["tod"] < last - 43200.0:     # midnight without an RMC date
             day = date.fromordinal(day.toordinal() + 1)
-        days.append(day)
-        last = tod
-    ns = np.array([int(datetime(d.year, d.month, d.day, tzinfo=timezone.utc).timestamp()) * 10**9
-                   + int(round(tod * 1e9)) for d, tod in zip(days, fixes)], dtype=np.int64)
-    week, sow = utc_to_gps_arrays(ns)
-    ep = [epochs[t] for t in fixes]
-    lat, lon, h = (np.radians([e["lat"] for e in ep]), np.radians([e["lon"] for e in ep]),
-                   np.array([e["h"] for e in ep]))
-    vel = np.array([e.get("vel", (np.nan, np.nan, np.nan)) for e in ep])
-    sig = np.array([e.get("sigma", (np.nan, np.nan, np.nan)) for e in ep])
-    return Record(week, sow, frames.lla_to_ecef(lat, lon, h), np.array([e["line"] for e in ep]), src,
+        last = e["tod"]
+        ns.append(int(datetime(day.year, day.month, day.day, tzinfo=timezone.utc).timestamp()) * 10**9
+                  + int(round(e["tod"] * 1e9)))
+    week, sow = utc_to_gps_arrays(np.array(ns, dtype=np.int64))
+    lat, lon, h = (np.radians([e["lat"] for e in fixes]), np.radians([e["lon"] for e in fixes]),
+                   np.array([e["h"] for e in fixes]))
+    vel = np.array([e.get("vel", (np.nan, np.nan, np.nan)) for e in fixes])
+    sig = np.array([e.get("sigma", (np.nan, np.nan, np.nan)) for e in fixes])
+    return Record(week, sow, frames.lla_to_ecef(lat, lon, h), np.array([e["line"] for e in fixes]), src,
                   sigma_enu=sig if np.isfinite(sig).all() else None,
                   vel_enu=vel if np.isfinite(vel).any() else None)
 

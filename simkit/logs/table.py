@@ -91,15 +91,11 @@ def read_csv(path) -> Record:
     if pos is None:
         raise DataFileError(src, "position: expected lat_deg, lon_deg, h_m (or lat_rad, lon_rad, h_m) or "
                                  "x_ecef_m, y_ecef_m, z_ecef_m columns")
-    vel = g([f"vel_{a}_m_per_s" for a in "enu"], "velocity")
-    sd_vel = g([f"sd_vel_{a}_m_per_s" for a in "enu"], "velocity sigma")
-    if vel is None and "vel_d_m_per_s" in header:
-        vel = frames.ned_to_enu(g([f"vel_{a}_m_per_s" for a in "ned"], "velocity"))
-    if sd_vel is None and "sd_vel_d_m_per_s" in header:
-        sd_vel = g([f"sd_vel_{a}_m_per_s" for a in "end"], "velocity sigma")
-    sd = g(["sd_e_m", "sd_n_m", "sd_u_m"], "position sigma")
-    if sd is None and "sd_d_m" in header:
-        sd = g(["sd_e_m", "sd_n_m", "sd_d_m"], "position sigma")
+    ned = "vel_d_m_per_s" in header            # the third axis names the convention
+    vel = g([f"vel_{a}_m_per_s" for a in ("ned" if ned else "enu")], "velocity")
+    vel = frames.ned_to_enu(vel) if ned and vel is not None else vel
+    sd_vel = g([f"sd_vel_{a}_m_per_s" for a in ("end" if "sd_vel_d_m_per_s" in header else "enu")], "velocity sigma")
+    sd = g(["sd_e_m", "sd_n_m", "sd_d_m" if "sd_d_m" in header else "sd_u_m"], "position sigma")
     euler = None
     for unit, scale in (("deg", _DEG), ("rad", 1.0)):
         rph = g([f"roll_{unit}", f"pitch_{unit}", f"heading_{unit}"], "attitude")

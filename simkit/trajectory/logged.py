@@ -72,8 +72,9 @@ class FitOptions:
     max_speed_m_per_s: float = 500.0
 
 
-def check(track: Track, opts: FitOptions, sigma_m: float) -> None:
-    """Refuse a log that cannot be a trajectory: one DataFileError naming the file and line."""
+def check(track: Track, opts: FitOptions) -> None:
+    """Refuse a log that cannot be a trajectory (too few samples, time not increasing, a gap above the limit):
+    one DataFileError naming the file and line."""
     src = track.source
     if len(track.t) < MIN_POINTS:
         raise DataFileError(src, f"{len(track.t)} usable samples in the scenario's time span, need at least "
@@ -91,6 +92,11 @@ def check(track: Track, opts: FitOptions, sigma_m: float) -> None:
         raise DataFileError(src, f"gap of {dt[k]:.1f} s before this sample (after line {track.line[k]}) is longer "
                                  f"than trajectory.max_gap_s = {opts.max_gap_s:g}: raise it to bridge the gap, or "
                                  f"select a part of the log with scenario.start / duration_s", int(track.line[k + 1]))
+
+
+def check_jumps(track: Track, opts: FitOptions, sigma_m: float) -> None:
+    """Refuse a step between samples faster than ``max_speed_m_per_s`` plus 6 sigma of noise (``sigma_m``)."""
+    src, dt = track.source, np.diff(track.t)
     step = np.linalg.norm(np.diff(track.pos_ecef, axis=0), axis=1)
     allowed = opts.max_speed_m_per_s * dt + 6.0 * np.sqrt(2.0) * sigma_m
     if np.any(step > allowed):
@@ -128,9 +134,10 @@ class LoggedPath:
         self.r0 = track.pos_ecef[0].copy()
         self.c_le = frames.ecef_to_enu_matrix(lla0[0], lla0[1]).T          # L (ENU at r0) -> ECEF
         local = (track.pos_ecef - self.r0) @ self.c_le
+        check(track, opts)
         sig, self.sigma_source = _sigmas(track, local, opts)
         self.sigma_m = np.sqrt(np.mean(sig**2, axis=0))
-        check(track, opts, float(np.max(self.sigma_m)))
+        check_jumps(track, opts, float(np.max(self.sigma_m)))
         t = track.t
         if t[0] > 1e-9 or t[-1] < duration_s - 1e-9:
             raise DataFileError(track.source, f"the log covers {t[0]:.3f} s to {t[-1]:.3f} s from scenario.start, "

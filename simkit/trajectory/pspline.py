@@ -20,11 +20,11 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.interpolate import BSpline
-from scipy.linalg import solveh_banded
+from scipy.linalg import LinAlgError, solveh_banded
 from scipy import sparse
 
 DEGREE = 5
-_LOG_LAM = (-12.0, 16.0)
+_LOG_LAM = (-10.0, 12.0)
 _BISECTIONS = 48
 
 
@@ -86,10 +86,24 @@ def smooth(t_knots, x, y, sigma, xv=None, v=None, sigma_v=None) -> tuple[BSpline
         return c, rss
 
     lo, hi = _LOG_LAM
-    c_hi, rss_hi = solve(hi)
+    # at the extremes the system can be numerically singular (a penalty too weak for more coefficients than
+    # samples, or too strong beside the data): step inwards until it solves
+    while True:
+        try:
+            c_hi, rss_hi = solve(hi)
+            break
+        except LinAlgError:
+            hi -= 1.0
     if rss_hi <= target:          # a quadratic already fits within the noise
         return BSpline(t_knots, c_hi, DEGREE), 10.0 ** hi * scale, rss_hi
-    best = solve(lo)
+    while True:
+        try:
+            best = solve(lo)
+            break
+        except LinAlgError:
+            lo += 1.0
+            if lo >= hi:
+                raise
     for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
         c, rss = solve(mid)
