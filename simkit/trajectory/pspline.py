@@ -116,8 +116,8 @@ def smooth(t_knots, x, y, sigma, xv=None, v=None, sigma_v=None) -> tuple[BSpline
 
 def noise_sigma(t, y) -> float:
     """Noise standard deviation of samples ``y`` of a smooth curve, from their third differences: for white noise
-    var(D3 y) = 20 sigma^2 (coefficients 1, -3, 3, -1); a robust scale (1.4826 MAD) ignores the few differences a
-    manoeuvre dominates. Only runs of four near-uniformly spaced samples (intervals within 10 %) are used; NaN
+    var(D3 y) = 20 sigma^2 (coefficients 1, -3, 3, -1). A robust scale (1.4826 MAD) first sets aside the few
+    differences a manoeuvre dominates (beyond 4 of its sigmas); the RMS of the rest gives the estimate. Only runs of four near-uniformly spaced samples (intervals within 10 %) are used; NaN
     when there are none."""
     dt = np.diff(t)
     uniform = (np.abs(dt[1:] / dt[:-1] - 1.0) < 0.1)
@@ -125,5 +125,6 @@ def noise_sigma(t, y) -> float:
     d3 = np.diff(y, 3)[ok]
     if d3.size == 0:
         return float("nan")
-    mad = np.median(np.abs(d3 - np.median(d3)))
-    return float(1.4826 * mad / np.sqrt(20.0))
+    rough = 1.4826 * np.median(np.abs(d3 - np.median(d3)))
+    inliers = d3[np.abs(d3) <= 4.0 * rough]        # then the efficient RMS of the differences within 4 sigma
+    return float(np.sqrt(np.mean(inliers**2) / 20.0)) if inliers.size else float("nan")
