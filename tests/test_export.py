@@ -64,7 +64,8 @@ def test_bag_counts_and_stamps_equal_the_file(h5, bag):
     n, m = len(tr.t), len(gnss_t)
     counts = {k: len(v) for k, v in bag.items()}
     assert counts == {"/tf_static": 1, "/ground_truth/pose": n, "/ground_truth/odom": n, "/tf": n, "/imu/data": len(imu.t),
-                      **{f"/gnss/ant{k}/fix": m for k in range(tr.lever_arm_b.shape[0])}}
+                      **{f"/gnss/ant{k}/fix": m for k in range(tr.lever_arm_b.shape[0])},
+                      "/solutions/pert/fix": len(tr.t[::10])}
     for topic, t in (("/imu/data", imu.t), ("/ground_truth/odom", tr.t), ("/gnss/ant1/fix", gnss_t)):
         stamps = np.array([s for s, _ in bag[topic]])
         headers = np.array([msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec for _, msg in bag[topic]])
@@ -110,6 +111,10 @@ def test_bag_pose_and_fixes_through_pymap3d(h5, bag):
         fix = np.array([[m.latitude, m.longitude, m.altitude] for _, m in bag[f"/gnss/ant{k}/fix"]])
         assert fix[:, :2] == pytest.approx(np.stack([lat, lon], -1), abs=1e-10)
         assert fix[:, 2] == pytest.approx(h, abs=1e-5)
+    sol = np.array([[m.latitude, m.longitude, m.altitude] for _, m in bag["/solutions/pert/fix"]])
+    with open_dataset(h5) as ds:
+        pert = ds["solutions/pert/pos_ecef"][:]
+    assert sol == pytest.approx(np.stack(pymap3d.ecef2geodetic(*pert.T), -1), abs=1e-6)
     static = {(t.header.frame_id, t.child_frame_id): t.transform for t in bag["/tf_static"][0][1].transforms}
     g1 = static[("base_link", "gnss1_link")].translation
     lever = at.lever_arm_b[1]

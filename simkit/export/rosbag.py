@@ -6,6 +6,7 @@ Topics (REP-103 axes, REP-105 frame names):
 |---|---|---|---|
 | /imu/data | sensor_msgs/msg/Imu | imu_link | gyro and accel in FLU; orientation unknown (covariance[0] = -1) |
 | /gnss/ant<k>/fix | sensor_msgs/msg/NavSatFix | gnss<k>_link | true phase centre of antenna k (+ white noise of ``fix_sigma_m``), ellipsoidal height |
+| /solutions/<name>/fix | sensor_msgs/msg/NavSatFix | gnss<k>_link for a solution of antenna k, else base_link | each /solutions group with positions (SPP, filters): its epochs with a position, ENU covariance from its pos_e/pos_n/pos_u states when present |
 | /ground_truth/odom | nav_msgs/msg/Odometry | map -> base_link | pose in map (ENU at the first truth sample), twist in base_link (FLU), relative to the Earth |
 | /ground_truth/pose | geometry_msgs/msg/PoseStamped | map | the same pose |
 | /tf | tf2_msgs/msg/TFMessage | map -> base_link | the same pose |
@@ -141,6 +142,35 @@ def _fill(w, ts, s: FileStreams, stamp, fix_sigma_m, seed):
             put(ci, i_ns[i], msg, kinds["imu"])
     if s.antenna_ecef is not None:
         _fixes(w, ts, s, stamp, fix_sigma_m, seed, conn, put)
+    for name, sol in s.solutions.items():
+        if sol.pos_ecef is not None:
+            _solution_fixes(ts, s.start, name, sol, stamp, conn, put)
+
+
+def solution_topic(name: str) -> str:
+    return f"/solutions/{name}/fix"
+
+
+def _solution_fixes(ts, start, name, sol, stamp, conn, put):
+    M = ts.types
+    Fix, status = M["sensor_msgs/msg/NavSatFix"], M["sensor_msgs/msg/NavSatStatus"]
+    ok = np.isfinite(sol.pos_ecef).all(axis=1)
+    t_ns = stamps_ns(start, sol.t[ok], stamp)
+    lla = frames.ecef_to_lla(sol.pos_ecef[ok])
+    names = list(sol.state_names)
+    cov = None
+    if sol.cov is not None and all(f"pos_{a}" in names for a in "enu"):
+        idx = [names.index(f"pos_{a}") for a in "enu"]
+        cov = sol.cov[ok][:, idx][:, :, idx].reshape(-1, 9)
+    frame = f"gnss{sol.point.split(':')[1]}_link" if sol.point.startswith("antenna:") else BASE
+    ck = conn(solution_topic(name), "sensor_msgs/msg/NavSatFix")
+    for i in range(len(t_ns)):
+        msg = Fix(header=_header(ts, t_ns[i], frame),
+                  status=status(status=status.STATUS_FIX, service=status.SERVICE_GPS | status.SERVICE_COMPASS),
+                  latitude=float(np.degrees(lla[i, 0])), longitude=float(np.degrees(lla[i, 1])),
+                  altitude=float(lla[i, 2]), position_covariance=np.zeros(9) if cov is None else cov[i],
+                  position_covariance_type=Fix.COVARIANCE_TYPE_UNKNOWN if cov is None else Fix.COVARIANCE_TYPE_KNOWN)
+        put(ck, t_ns[i], msg, "sensor_msgs/msg/NavSatFix")
 
 
 def _fixes(w, ts, s, stamp, sigma, seed, conn, put):
