@@ -25,6 +25,11 @@ def export(path, fmt: str, out, frame: str = "ned-frd", stamp: str = "unix", fix
         raise InputError("--stamp", f"expected one of {', '.join(STAMPS)}, got {stamp!r}")
     if fix_sigma_m < 0:
         raise InputError("--fix-sigma-m", f"expected a number >= 0, got {fix_sigma_m!r}")
+    if fmt == "rosbag2":
+        import importlib.util
+
+        if importlib.util.find_spec("rosbags") is None:
+            raise InputError("--format rosbag2", "needs the 'rosbags' package: pip install 'simkit[export]'")
     streams = read_streams(path)
     out = Path(out)
     if fmt == "csv":
@@ -35,9 +40,6 @@ def export(path, fmt: str, out, frame: str = "ned-frd", stamp: str = "unix", fix
         from . import kmlout
 
         return [kmlout.write(streams, out, rate_hz)]
-    try:
-        from . import rosbag
-        import rosbags  # noqa: F401
-    except ImportError:
-        raise InputError("--format rosbag2", "needs the 'rosbags' package: pip install 'simkit[export]'") from None
+    from . import rosbag
+
     return [rosbag.write(streams, out, stamp, fix_sigma_m, seed)]

@@ -15,7 +15,6 @@ from scipy.spatial.transform import Rotation
 from .. import frames, gpstime
 from ..earth import EARTH_RATE_ECEF
 from ..errors import DataFileError
-from ..solution import Solution
 
 BODY_FRAMES = ("ned-frd", "enu-rfu", "enu-flu")
 RFU_TO_FLU = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])   # v_flu = RFU_TO_FLU @ v_rfu

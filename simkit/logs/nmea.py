@@ -41,74 +41,109 @@ def _tod(value: str) -> float:
 def read(path, date_hint: date | None = None) -> Record:
     """The GGA fixes of an NMEA file, with RMC/VTG velocity and GST sigmas where present."""
     src = str(path)
-    fixes: list[dict] = []           # one per GGA, in file order
-    pending: dict[float, dict] = {}  # RMC / GST / VTG data that came before the GGA of their epoch
-    current = None                   # time of day of the last time-bearing sentence (VTG has none)
     try:
         text = open(path, encoding="ascii", errors="replace").read()
     except OSError as exc:
         raise DataFileError(src, f"cannot read: {exc}") from None
+    fixes = _parse(src, text)
+    if not fixes:
+        raise DataFileError(src, "no GGA fix (quality > 0) found: NMEA logs need GGA for positions and heights")
+    week, sow = utc_to_gps_arrays(_utc_ns(src, fixes, date_hint))
+    lat, lon, h = (np.radians([e["lat"] for e in fixes]), np.radians([e["lon"] for e in fixes]),
+                   np.array([e["h"] for e in fixes]))
+    vel = np.array([e.get("vel", (np.nan, np.nan, np.nan)) for e in fixes])
+    sig = np.array([e.get("sigma", (np.nan, np.nan, np.nan)) for e in fixes])
+    return Record(week, sow, frames.lla_to_ecef(lat, lon, h), np.array([e["line"] for e in fixes]), src,
+                  sigma_enu=sig if np.isfinite(sig).all() else None,
+                  vel_enu=vel if np.isfinite(vel).any() else None)
 
-    def epoch(tod):
-        if fixes and fixes[-1]["tod"] == tod:
-            return fixes[-1]
-        return pending.setdefault(tod, {})
 
+def _fields(src, n, line):
+    """The comma-separated fields of a sentence after its checksum is verified."""
+    if not line.startswith("$"):
+        raise DataFileError(src, f"expected an NMEA sentence starting with '$', got {line[:20]!r}", n)
+    body, star, check = line[1:].partition("*")
+    if star:
+        try:
+            ok = int(check[:2], 16) == _checksum(body)
+        except ValueError:
+            ok = False
+        if not ok:
+            raise DataFileError(src, f"bad checksum *{check} (computed *{_checksum(body):02X})", n)
+    return body.split(",")
+
+
+class _Epochs:
+    """One sample per GGA with a fix, in file order; RMC / GST / VTG data join the GGA of their time of day."""
+
+    def __init__(self):
+        self.fixes: list[dict] = []
+        self.pending: dict[float, dict] = {}   # data that came before the GGA of their epoch
+        self.current = None                    # time of day of the last time-bearing sentence (VTG has none)
+
+    def of(self, tod):
+        if self.fixes and self.fixes[-1]["tod"] == tod:
+            return self.fixes[-1]
+        return self.pending.setdefault(tod, {})
+
+    def gga(self, f, n):
+        if len(f) < 12:
+            raise ValueError("GGA needs 14 fields")
+        if not f[1]:
+            return
+        self.current = tod = _tod(f[1])
+        if not f[6] or int(f[6]) == 0 or not f[2]:
+            return
+        if not f[9] or not f[11]:
+            raise ValueError("altitude or geoid separation empty: the ellipsoidal height is unknown")
+        self.fixes.append(dict(self.pending.pop(tod, {}), tod=tod, lat=_angle(f[2], f[3], 2),
+                               lon=_angle(f[4], f[5], 3), h=float(f[9]) + float(f[11]), line=n))
+
+    def rmc(self, f, n):
+        if len(f) < 10:
+            raise ValueError("RMC needs at least 10 fields")
+        if not f[1]:
+            return
+        self.current = tod = _tod(f[1])
+        e = self.of(tod)
+        if f[9]:
+            yy = int(f[9][4:6])      # two digits: 80-99 are 1980-1999 (GPS began in 1980)
+            e["day"] = date((1900 if yy >= 80 else 2000) + yy, int(f[9][2:4]), int(f[9][0:2]))
+        if f[2] == "A" and f[7] and f[8]:
+            _velocity(e, float(f[7]) * KNOT, float(f[8]))
+
+    def vtg(self, f, n):
+        if self.current is not None and len(f) > 7 and f[1] and f[7]:
+            _velocity(self.of(self.current), float(f[7]) / 3.6, float(f[1]))
+
+    def gst(self, f, n):
+        if len(f) < 9:
+            raise ValueError("GST needs 9 fields")
+        if f[1] and f[6] and f[7] and f[8]:
+            self.current = tod = _tod(f[1])
+            self.of(tod)["sigma"] = (float(f[7]), float(f[6]), float(f[8]))
+
+
+def _parse(src, text) -> list[dict]:
+    epochs = _Epochs()
+    handlers = {"GGA": epochs.gga, "RMC": epochs.rmc, "VTG": epochs.vtg, "GST": epochs.gst}
     for n, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         if not line:
             continue
-        if not line.startswith("$"):
-            raise DataFileError(src, f"expected an NMEA sentence starting with '$', got {line[:20]!r}", n)
-        body, star, check = line[1:].partition("*")
-        if star:
-            try:
-                ok = int(check[:2], 16) == _checksum(body)
-            except ValueError:
-                ok = False
-            if not ok:
-                raise DataFileError(src, f"bad checksum *{check} (computed *{_checksum(body):02X})", n)
-        f = body.split(",")
-        kind = f[0][-3:]
+        f = _fields(src, n, line)
+        handler = handlers.get(f[0][-3:])
+        if handler is None:
+            continue
         try:
-            if kind == "GGA":
-                if len(f) < 12:
-                    raise ValueError("GGA needs 14 fields")
-                if not f[1]:
-                    continue
-                current = tod = _tod(f[1])
-                if not f[6] or int(f[6]) == 0 or not f[2]:
-                    continue
-                if not f[9] or not f[11]:
-                    raise ValueError("altitude or geoid separation empty: the ellipsoidal height is unknown")
-                fix = dict(pending.pop(tod, {}), tod=tod, lat=_angle(f[2], f[3], 2), lon=_angle(f[4], f[5], 3),
-                           h=float(f[9]) + float(f[11]), line=n)
-                fixes.append(fix)
-            elif kind == "RMC":
-                if len(f) < 10:
-                    raise ValueError("RMC needs at least 10 fields")
-                if not f[1]:
-                    continue
-                current = tod = _tod(f[1])
-                e = epoch(tod)
-                if f[9]:
-                    yy = int(f[9][4:6])      # two digits: 80-99 are 1980-1999 (GPS began in 1980)
-                    e["day"] = date((1900 if yy >= 80 else 2000) + yy, int(f[9][2:4]), int(f[9][0:2]))
-                if f[2] == "A" and f[7] and f[8]:
-                    _velocity(e, float(f[7]) * KNOT, float(f[8]))
-            elif kind == "VTG":
-                if current is not None and len(f) > 7 and f[1] and f[7]:
-                    _velocity(epoch(current), float(f[7]) / 3.6, float(f[1]))
-            elif kind == "GST":
-                if len(f) < 9:
-                    raise ValueError("GST needs 9 fields")
-                if f[1] and f[6] and f[7] and f[8]:
-                    current = tod = _tod(f[1])
-                    epoch(tod)["sigma"] = (float(f[7]), float(f[6]), float(f[8]))
+            handler(f, n)
         except (ValueError, IndexError) as exc:
-            raise DataFileError(src, f"malformed {kind} sentence: {exc}", n) from None
-    if not fixes:
-        raise DataFileError(src, "no GGA fix (quality > 0) found: NMEA logs need GGA for positions and heights")
+            raise DataFileError(src, f"malformed {f[0][-3:]} sentence: {exc}", n) from None
+    return epochs.fixes
+
+
+def _utc_ns(src, fixes, date_hint) -> np.ndarray:
+    """UTC nanoseconds since 1970 of the fixes: RMC dates where given, else ``date_hint`` rolled at midnight."""
     dated = [e["day"] for e in fixes if "day" in e]
     if not dated and date_hint is None:
         raise DataFileError(src, "no RMC date and no date given: set scenario.start")
@@ -121,14 +156,7 @@ def read(path, date_hint: date | None = None) -> Record:
         last = e["tod"]
         ns.append(int(datetime(day.year, day.month, day.day, tzinfo=timezone.utc).timestamp()) * 10**9
                   + int(round(e["tod"] * 1e9)))
-    week, sow = utc_to_gps_arrays(np.array(ns, dtype=np.int64))
-    lat, lon, h = (np.radians([e["lat"] for e in fixes]), np.radians([e["lon"] for e in fixes]),
-                   np.array([e["h"] for e in fixes]))
-    vel = np.array([e.get("vel", (np.nan, np.nan, np.nan)) for e in fixes])
-    sig = np.array([e.get("sigma", (np.nan, np.nan, np.nan)) for e in fixes])
-    return Record(week, sow, frames.lla_to_ecef(lat, lon, h), np.array([e["line"] for e in fixes]), src,
-                  sigma_enu=sig if np.isfinite(sig).all() else None,
-                  vel_enu=vel if np.isfinite(vel).any() else None)
+    return np.array(ns, dtype=np.int64)
 
 
 def _velocity(epoch: dict, speed: float, course_deg: float) -> None:

@@ -28,7 +28,7 @@ def _rows(src, text):
     header = [c.strip() for c in lines[0][1].split(",")]
     if len(set(header)) != len(header):
         raise DataFileError(src, "duplicate column names in the header", lines[0][0])
-    cells, numbers = [], []
+    cells = []
     for n, ln in lines[1:]:
         row = [c.strip() for c in ln.split(",")]
         if len(row) != len(header):

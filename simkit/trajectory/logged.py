@@ -29,11 +29,11 @@ from .. import earth, frames
 from ..earth import G0
 from ..errors import DataFileError
 from . import pspline
-from .generator import TrajectoryTruth, body_rate_nb
+from .truth import TrajectoryTruth, body_rate_nb
 
 ATTITUDE_RULES = ("log", "ground", "coordinated")
 MIN_POINTS = 4
-MIN_SPEED_M_PER_S = 0.5            # the velocity-following rules need a direction of motion
+MIN_SPEED_M_PER_S = 1.0            # the velocity-following rules need a direction of motion
 _SIGMA_FLOOR_M = 1e-3              # an exact (noise-free) log still gets finite weights
 _SIGMA_FLOOR_RAD = 1e-6
 
@@ -130,11 +130,11 @@ class LoggedPath:
         self.rule = opts.attitude or ("log" if track.euler is not None else "ground")
         if self.rule == "log" and track.euler is None:
             raise DataFileError(track.source, "trajectory.attitude = 'log' but the log has no attitude")
+        check(track, opts)
         lla0 = frames.ecef_to_lla(track.pos_ecef[0])
         self.r0 = track.pos_ecef[0].copy()
         self.c_le = frames.ecef_to_enu_matrix(lla0[0], lla0[1]).T          # L (ENU at r0) -> ECEF
         local = (track.pos_ecef - self.r0) @ self.c_le
-        check(track, opts)
         sig, self.sigma_source = _sigmas(track, local, opts)
         self.sigma_m = np.sqrt(np.mean(sig**2, axis=0))
         check_jumps(track, opts, float(np.max(self.sigma_m)))
@@ -145,17 +145,26 @@ class LoggedPath:
                                               f"shorten scenario.duration_s")
         spacing = float(np.median(np.diff(t)))
         self.knots = pspline.knots(t[0], t[-1], spacing)
-        vel_l = sig_v = None
-        if track.vel_enu is not None:
-            lla = frames.ecef_to_lla(track.pos_ecef)
-            vel_e = frames.enu_to_ecef_vec(np.nan_to_num(track.vel_enu), lla[:, 0], lla[:, 1])
-            vel_l = vel_e @ self.c_le
-            vel_l[~np.isfinite(track.vel_enu)] = np.nan   # the axes stay near-aligned over a log's extent
-            sv = opts.velocity_sigma_m_per_s
-            sig_v = (np.full(vel_l.shape, sv) if sv is not None else
-                     track.sigma_vel if track.sigma_vel is not None else None)
-            if sig_v is None:
-                vel_l = None          # logged velocity without a stated accuracy is not used (documented)
+        self._fit_positions(track, local, sig, opts)
+        self.att_splines = None
+        if self.rule == "log":
+            self._fit_attitude(track, opts)
+        else:
+            self._check_motion(np.linspace(0.0, duration_s, max(2, int(np.ceil(duration_s / min(spacing, 0.1))) + 1)))
+
+    def _local_velocity(self, track: Track, opts: FitOptions):
+        """Logged velocities in L and their sigmas (K, 3), or (None, None) when absent or of unknown accuracy."""
+        sv = opts.velocity_sigma_m_per_s
+        if track.vel_enu is None or (sv is None and track.sigma_vel is None):
+            return None, None            # a logged velocity without a stated accuracy is not used (documented)
+        lla = frames.ecef_to_lla(track.pos_ecef)
+        vel_l = frames.enu_to_ecef_vec(np.nan_to_num(track.vel_enu), lla[:, 0], lla[:, 1]) @ self.c_le
+        vel_l[~np.isfinite(track.vel_enu)] = np.nan      # the axes stay near-aligned over a log's extent
+        return vel_l, (np.full(vel_l.shape, sv) if sv is not None else track.sigma_vel)
+
+    def _fit_positions(self, track, local, sig, opts):
+        t = track.t
+        vel_l, sig_v = self._local_velocity(track, opts)
         self.splines, self.lam, self.chi2 = [], [], []
         for i in range(3):
             kw = {}
@@ -167,28 +176,26 @@ class LoggedPath:
             self.lam.append(lam)
             self.chi2.append(chi2)
         self.residual_rms_m = np.sqrt(np.mean((np.stack([s(t) for s in self.splines], -1) - local) ** 2, axis=0))
-        self.att_splines = None
-        if self.rule == "log":
-            angles = np.array(track.euler, float)
-            angles[:, 2] = np.unwrap(angles[:, 2])
-            self.att_splines = []
-            for i in range(3):
-                sa = opts.attitude_sigma_rad or pspline.noise_sigma(t, angles[:, i])
-                sa = max(sa if np.isfinite(sa) else 0.0, _SIGMA_FLOOR_RAD)
-                self.att_splines.append(pspline.smooth(self.knots, t, angles[:, i], np.full(len(t), sa))[0])
-        else:
-            grid = np.linspace(0.0, duration_s, max(2, int(np.ceil(duration_s / min(spacing, 0.1))) + 1))
-            v = np.stack([s(grid, 1) for s in self.splines], -1)
-            vh = np.hypot(v[:, 0], v[:, 1])          # the tangent plane's horizontal, to within the log's extent
-            if vh.min() < 2 * MIN_SPEED_M_PER_S:
-                k = int(np.argmin(vh))
-                raise DataFileError(track.source, f"the fitted path slows to {vh[k]:.2f} m/s at {grid[k]:.1f} s: "
-                                                  f"attitude rule {self.rule!r} needs a horizontal speed of at "
-                                                  f"least {2 * MIN_SPEED_M_PER_S:g} m/s (give attitude in the log, "
-                                                  f"or select a moving part with scenario.start / duration_s)")
 
-    def start_lla(self) -> np.ndarray:
-        return frames.ecef_to_lla(self.truth(np.zeros(1)).pos_ecef[0])
+    def _fit_attitude(self, track, opts):
+        angles = np.array(track.euler, float)
+        angles[:, 2] = np.unwrap(angles[:, 2])
+        self.att_splines = []
+        for i in range(3):
+            sa = opts.attitude_sigma_rad or pspline.noise_sigma(track.t, angles[:, i])
+            sa = max(sa if np.isfinite(sa) else 0.0, _SIGMA_FLOOR_RAD)
+            self.att_splines.append(pspline.smooth(self.knots, track.t, angles[:, i], np.full(len(track.t), sa))[0])
+
+    def _check_motion(self, grid):
+        """The velocity-following rules need a direction of motion throughout the run."""
+        v = np.stack([s(grid, 1) for s in self.splines], -1)
+        vh = np.hypot(v[:, 0], v[:, 1])          # the tangent plane's horizontal, to within the log's extent
+        if vh.min() < MIN_SPEED_M_PER_S:
+            k = int(np.argmin(vh))
+            raise DataFileError(self.source, f"the fitted path slows to {vh[k]:.2f} m/s at {grid[k]:.1f} s: "
+                                             f"attitude rule {self.rule!r} needs a horizontal speed of at least "
+                                             f"{MIN_SPEED_M_PER_S:g} m/s (give attitude in the log, or select a "
+                                             f"moving part with scenario.start / duration_s)")
 
     def truth(self, t) -> TrajectoryTruth:
         """Truth at times ``t`` (N,) s since the scenario start."""
