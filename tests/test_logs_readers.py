@@ -236,3 +236,21 @@ def test_good_log_relative_to_the_scenario_runs(tmp_path):
     with pytest.raises((DataFileError, ScenarioError)):
         load({"scenario": {"name": "s", "start": "2026-04-27T06:00:01Z", "duration_s": 10.0},
               "trajectory": {"rate_hz": 10.0, "source": "a.nmea"}})   # a dict has no folder: cwd
+
+
+def test_a_run_from_a_log_records_the_log_and_the_fit(tmp_path):
+    import hashlib
+    import json
+
+    from simkit import run
+    from simkit.io import open_dataset
+
+    t, lat, lon, h = _good_nmea()
+    (tmp_path / "a.nmea").write_text(_nmea(t, lat, lon, h))
+    out = run(tmp_path / _scenario(tmp_path, "a.nmea", "position_sigma_m = 0.5\n"), out=tmp_path / "a.h5")
+    with open_dataset(out) as ds:
+        log = json.loads(ds.group_attrs("truth")["log"])
+        n = len(ds["truth/t"][:])
+    assert log["sha256"] == hashlib.sha256((tmp_path / "a.nmea").read_bytes()).hexdigest()
+    assert log["source"] == "a.nmea" and log["sigma_source"] == "stated" and log["attitude"] == "ground"
+    assert n == 101

@@ -2,6 +2,7 @@
 ``[trajectory] source = FILE`` (docs/logs_and_export.md)."""
 from __future__ import annotations
 
+import hashlib
 from dataclasses import replace
 from datetime import datetime
 from pathlib import Path
@@ -56,6 +57,8 @@ def fit_trajectory(cfg: TrajectoryConfig, base: Path | None, start: datetime, we
                                            f"does not cover scenario.start + {duration_s:g} s: move scenario.start "
                                            f"or shorten scenario.duration_s")
     fitted = LoggedPath(track, spec.fit, duration_s)
+    fitted.provenance = {"source": spec.source, "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+                         "samples_used": int(len(track.t))}
     first = fitted.truth([0.0])
     lat, lon, h = first.pos_lla[0]
     pitch, roll, heading = first.euler[0]

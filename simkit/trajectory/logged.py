@@ -197,6 +197,12 @@ class LoggedPath:
                                              f"{MIN_SPEED_M_PER_S:g} m/s (give attitude in the log, or select a "
                                              f"moving part with scenario.start / duration_s)")
 
+    def summary(self) -> dict:
+        """What the fit used and found (the ``log`` attribute of /truth): rule, sigmas and their source, residual
+        RMS per axis (m), plus whatever the reader added to ``provenance`` (file, digest)."""
+        return dict(getattr(self, "provenance", {}), attitude=self.rule, sigma_m=self.sigma_m.tolist(),
+                    sigma_source=self.sigma_source, residual_rms_m=self.residual_rms_m.tolist())
+
     def truth(self, t) -> TrajectoryTruth:
         """Truth at times ``t`` (N,) s since the scenario start."""
         t = np.asarray(t, dtype=float)
