@@ -142,6 +142,12 @@ def test_csv_in_ned_frd_scores_as_the_hdf5(h5, tmp_path):
     frd = lambda v: np.stack([v[:, 1], v[:, 0], -v[:, 2]], -1)    # x forward = y, y right = x, z down = -z
     got = np.stack([imu_csv[f"gyro_{a}_rad_per_s"] for a in "xyz"], -1)
     assert np.array_equal(got, frd(imu.gyro))
+    # truth.csv read back as a log: the file's epochs, positions and NED velocity to the written precision
+    rec = read(tmp_path / "csv" / "truth.csv")
+    tr, _, _, start = _file(h5)
+    assert np.abs(gpstime.diff_seconds(rec.week, rec.sow, *start) - tr.t).max() < 1e-9   # sow ~1e5 s: 1.5e-11 s ulp
+    assert np.abs(rec.pos_ecef - tr.pos_ecef).max() < 1e-8
+    assert np.array_equal(rec.vel_enu, tr.vel_enu)
 
 
 def test_kml_tracks_read_back(h5, tmp_path):

@@ -170,3 +170,25 @@ def test_sparse_and_gapped_gpx_logs(tmp_path, truth_10hz, every, sigma, gap, bou
           f"{np.sqrt(np.mean(err**2)):.2f} m, max {err.max():.2f} m; closure {pos_err:.1e} m")
     assert pos_err < 1e-4 and att_err < 1e-3
     assert np.sqrt(np.mean(err**2)) < bound
+
+
+def test_logged_velocity_with_a_stated_accuracy_tightens_the_fit(tmp_path, truth_10hz):
+    """RMC speed and course (the true horizontal velocity plus 0.1 m/s noise) enter the fit as slope rows when
+    trajectory.velocity_sigma_m_per_s states their accuracy; without it they are ignored (documented)."""
+    t, lat, lon, h, idx = noisy_log(truth_10hz, 10, SIGMA, seed=3)
+    vel = truth_10hz["vel_enu"][idx] + np.random.default_rng(4).normal(0.0, 0.1, (len(idx), 3))
+    path = tmp_path / "drive_rmc.nmea"
+    path.write_text("\n".join(nmea_lines(t, lat, lon, h, vel_enu=vel)) + "\n")
+    true100 = drive_truth(100.0)
+    k0 = int(OFFSET_S * 100)
+    rms = {}
+    for key, extra in (("positions", {}), ("with velocity", {"velocity_sigma_m_per_s": 0.1})):
+        _, rp = replay(path, position_sigma_m=SIGMA, **extra)
+        err = enu_errors(rp["pos_ecef"], true100["pos_lla"][k0:k0 + len(rp["t"])])
+        rms[key] = np.sqrt(np.mean(err[:, :2] ** 2))
+        if extra:
+            pos_err, _, att_err = _strapdown_errors(rp, 100.0)
+            assert pos_err < 1e-4 and att_err < 1e-3
+    print(f"\nhorizontal RMS error: positions only {rms['positions']:.3f} m, with RMC velocity "
+          f"{rms['with velocity']:.3f} m")
+    assert rms["with velocity"] < 0.8 * rms["positions"]

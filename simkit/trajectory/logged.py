@@ -168,8 +168,8 @@ class LoggedPath:
         self.splines, self.lam, self.chi2 = [], [], []
         for i in range(3):
             kw = {}
-            if vel_l is not None:
-                ok = np.isfinite(vel_l[:, i])
+            ok = np.isfinite(vel_l[:, i]) if vel_l is not None else np.zeros(len(t), bool)
+            if ok.any():                         # (RMC and VTG give no vertical velocity)
                 kw = dict(xv=t[ok], v=vel_l[ok, i], sigma_v=np.maximum(sig_v[ok, i], 1e-4))
             s, lam, chi2 = pspline.smooth(self.knots, t, local[:, i], sig[:, i], **kw)
             self.splines.append(s)
