@@ -192,3 +192,16 @@ def test_logged_velocity_with_a_stated_accuracy_tightens_the_fit(tmp_path, truth
     print(f"\nhorizontal RMS error: positions only {rms['positions']:.3f} m, with RMC velocity "
           f"{rms['with velocity']:.3f} m")
     assert rms["with velocity"] < 0.8 * rms["positions"]
+
+
+def test_the_bundled_example_replays_the_drive():
+    """examples/replay_drive.toml (its log made as in the first test, with RMC): the same accuracy."""
+    from pathlib import Path
+
+    sc = load(Path(__file__).resolve().parents[1] / "examples" / "replay_drive.toml", ["imu.preset=ideal"])
+    blocks = list(Trajectory(sc.trajectory, sc.duration_s).blocks())
+    rp = {k: np.concatenate([getattr(b, k) for b in blocks]) for k in blocks[0].arrays()}
+    true100 = drive_truth(100.0)
+    k0 = int(OFFSET_S * 100)
+    rms = np.sqrt(np.mean(enu_errors(rp["pos_ecef"], true100["pos_lla"][k0:k0 + len(rp["t"])]) ** 2, axis=0))
+    assert np.all(rms < SIGMA)
