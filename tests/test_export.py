@@ -168,3 +168,23 @@ def test_export_bad_input(h5, tmp_path):
     assert_clean_error(["export", str(h5), "--format", "csv", "-o", "taken"], tmp_path, "not a folder")
     proc = run_cli(["export", str(h5), "--format", "kml", "-o", "x.kml"], tmp_path)
     assert proc.returncode == 0 and (tmp_path / "x.kml").is_file()
+
+
+@pytest.mark.slow
+def test_full_airborne_stim300_bag_counts_and_stamps(tmp_path):
+    """The whole 1000 s scenario: every message is in the bag, stamped at the file's epochs."""
+    path = run("airborne_stim300", out=tmp_path / "air.h5")
+    export(path, "rosbag2", tmp_path / "bag", stamp="gps")
+    with open_dataset(path) as ds:
+        t, imu_t, gnss_t = ds["truth/t"][:], ds["imu/t"][:], ds["gnss/t"][:]
+        week, sow = int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"])
+    base = (week * 604800 + int(sow)) * 10**9
+    with Reader(tmp_path / "bag") as r:
+        counts = {c.topic: c.msgcount for c in r.connections}
+        stamps = {}
+        for conn, stamp, _ in r.messages():
+            stamps.setdefault(conn.topic, []).append(stamp)
+    assert counts["/imu/data"] == len(imu_t) == 100001 and counts["/ground_truth/odom"] == len(t)
+    assert counts["/gnss/ant2/fix"] == len(gnss_t)
+    assert np.array_equal(stamps["/imu/data"], base + np.round(imu_t * 1e9).astype(np.int64))
+    assert np.array_equal(stamps["/gnss/ant0/fix"], base + np.round(gnss_t * 1e9).astype(np.int64))
