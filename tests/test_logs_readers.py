@@ -254,3 +254,14 @@ def test_a_run_from_a_log_records_the_log_and_the_fit(tmp_path):
     assert log["sha256"] == hashlib.sha256((tmp_path / "a.nmea").read_bytes()).hexdigest()
     assert log["source"] == "a.nmea" and log["sigma_source"] == "stated" and log["attitude"] == "ground"
     assert n == 101
+
+
+def test_a_long_gap_in_the_margin_outside_the_run_is_not_an_error(tmp_path):
+    """Samples up to 30 s outside the run steady its ends; a long gap among them is cut off, not refused."""
+    t, lat, lon, h = _good_nmea(n=40)
+    keep = (t < 3) | (t > 16)             # a 14 s gap from 2 s to 17 s, then the run from 18 s
+    (tmp_path / "a.nmea").write_text(_nmea(t[keep], lat[keep], lon[keep], h[keep]))
+    text = (tmp_path / _scenario(tmp_path, "a.nmea", "position_sigma_m = 0.5\n")).read_text()
+    (tmp_path / "s.toml").write_text(text.replace("06:00:01Z", "06:00:18Z"))
+    sc = load(tmp_path / "s.toml")
+    assert sc.trajectory.path.summary()["samples_used"] == 23     # 17..39 s: the samples before the gap are dropped

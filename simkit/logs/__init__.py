@@ -7,6 +7,8 @@ from dataclasses import replace
 from datetime import datetime
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import DataFileError, ScenarioError
 from ..trajectory import TrajectoryConfig
 from ..trajectory.logged import LoggedPath
@@ -56,14 +58,27 @@ def fit_trajectory(cfg: TrajectoryConfig, base: Path | None, start: datetime, we
         raise DataFileError(record.source, f"the log spans {record.span_text()}, which "
                                            f"does not cover scenario.start + {duration_s:g} s: move scenario.start "
                                            f"or shorten scenario.duration_s")
+    track = _margins_without_gaps(track, spec.fit.max_gap_s, duration_s)
     fitted = LoggedPath(track, spec.fit, duration_s)
     fitted.provenance = {"source": spec.source, "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
                          "samples_used": int(len(track.t))}
     first = fitted.truth([0.0])
     lat, lon, h = first.pos_lla[0]
     pitch, roll, heading = first.euler[0]
-    import numpy as np
 
     return replace(cfg, path=fitted, lat_rad=float(lat), lon_rad=float(lon), height_m=float(h),
                    speed_m_per_s=float(np.linalg.norm(first.vel_enu[0])), flight_path_rad=float(pitch),
                    heading_rad=float(heading), roll_rad=float(roll))
+
+
+def _margins_without_gaps(track, max_gap_s: float, duration_s: float):
+    """Drop the margin samples beyond a long gap that lies wholly outside the run: only a gap inside
+    [0, duration_s] is the run's problem."""
+    dt = np.diff(track.t)
+    first, last = 0, len(track.t)
+    for k in np.nonzero(dt > max_gap_s)[0]:
+        if track.t[k + 1] <= 0.0:
+            first = k + 1
+        elif track.t[k] >= duration_s and last == len(track.t):
+            last = k + 1
+    return track.take(slice(first, last))
