@@ -166,6 +166,13 @@ def test_export_bad_input(h5, tmp_path):
     (tmp_path / "taken").write_text("x")
     assert_clean_error(["export", "missing.h5", "--format", "csv", "-o", "out"], tmp_path, "missing.h5")
     assert_clean_error(["export", str(h5), "--format", "csv", "-o", "taken"], tmp_path, "not a folder")
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "notes.txt").write_text("keep me")
+    assert_clean_error(["export", str(h5), "--format", "rosbag2", "-o", "data"], tmp_path, "not a rosbag2 folder")
+    assert (tmp_path / "data" / "notes.txt").read_text() == "keep me"
+    assert run_cli(["export", str(h5), "--format", "rosbag2", "-o", "bag"], tmp_path).returncode == 0
+    assert run_cli(["export", str(h5), "--format", "rosbag2", "-o", "bag"], tmp_path).returncode == 0  # replaced
+    assert sorted(p.name for p in (tmp_path / "bag").iterdir()) == ["bag.db3", "metadata.yaml"]
     proc = run_cli(["export", str(h5), "--format", "kml", "-o", "x.kml"], tmp_path)
     assert proc.returncode == 0 and (tmp_path / "x.kml").is_file()
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, OutputError
 from .streams import BODY_FRAMES, STAMPS, read_streams
 
 FORMATS = ("rosbag2", "csv", "kml")
@@ -25,13 +25,14 @@ def export(path, fmt: str, out, frame: str = "ned-frd", stamp: str = "unix", fix
         raise InputError("--stamp", f"expected one of {', '.join(STAMPS)}, got {stamp!r}")
     if fix_sigma_m < 0:
         raise InputError("--fix-sigma-m", f"expected a number >= 0, got {fix_sigma_m!r}")
+    out = Path(out)
     if fmt == "rosbag2":
         import importlib.util
 
         if importlib.util.find_spec("rosbags") is None:
             raise InputError("--format rosbag2", "needs the 'rosbags' package: pip install 'simkit[export]'")
+        _replaceable_bag(out)
     streams = read_streams(path)
-    out = Path(out)
     if fmt == "csv":
         from . import csvout
 
@@ -43,3 +44,10 @@ def export(path, fmt: str, out, frame: str = "ned-frd", stamp: str = "unix", fix
     from . import rosbag
 
     return [rosbag.write(streams, out, stamp, fix_sigma_m, seed)]
+
+
+def _replaceable_bag(out: Path) -> None:
+    """A bag replaces only an earlier bag (a folder holding nothing but metadata.yaml and .db3/.mcap files)."""
+    if out.is_dir() and any(p.name != "metadata.yaml" and p.suffix not in (".db3", ".mcap") for p in out.iterdir()):
+        raise OutputError(out, "exists and is not a rosbag2 folder: expected a new folder name or an earlier bag "
+                               "to replace")
