@@ -195,3 +195,26 @@ def test_full_airborne_stim300_bag_counts_and_stamps(tmp_path):
     assert counts["/gnss/ant2/fix"] == len(gnss_t)
     assert np.array_equal(stamps["/imu/data"], base + np.round(imu_t * 1e9).astype(np.int64))
     assert np.array_equal(stamps["/gnss/ant0/fix"], base + np.round(gnss_t * 1e9).astype(np.int64))
+
+
+def test_pyins_reads_the_ned_csvs_and_finds_the_referees_errors(h5, tmp_path):
+    """A peer's loader: pyins takes NED DataFrames (lat, lon, alt, VN, VE, VD, roll, pitch, heading in degrees):
+    the exported CSVs are that after a column rename, and pyins' state difference of the solution against the
+    truth is the referee's error (to pyins' first-order lat/lon scaling)."""
+    import pandas as pd
+    from pyins import transform as pyins_transform
+
+    export(h5, "csv", tmp_path / "csv", frame="ned-frd")
+    names = {"lat_deg": "lat", "lon_deg": "lon", "h_m": "alt", "vel_n_m_per_s": "VN", "vel_e_m_per_s": "VE",
+             "vel_d_m_per_s": "VD", "roll_deg": "roll", "pitch_deg": "pitch", "heading_deg": "heading"}
+
+    def load(name):
+        df = pd.read_csv(tmp_path / "csv" / name, comment="#").rename(columns=names)
+        return df.set_index("t_s")[list(names.values())]
+
+    diff = pyins_transform.compute_state_difference(load("solution_pert.csv"), load("truth.csv"))
+    sc = score(h5, h5, solution="pert")
+    diff = diff.loc[sc.errors.t]
+    np.testing.assert_allclose(sc.errors.pos_enu, diff[["east", "north", "down"]].values * [1, 1, -1], atol=2e-3)
+    np.testing.assert_allclose(sc.errors.vel_enu, diff[["VE", "VN", "VD"]].values * [1, 1, -1], atol=1e-9)
+    np.testing.assert_allclose(np.degrees(sc.errors.euler), diff[["pitch", "roll", "heading"]].values, atol=1e-7)
