@@ -254,6 +254,10 @@ def test_a_run_from_a_log_records_the_log_and_the_fit(tmp_path):
     assert log["sha256"] == hashlib.sha256((tmp_path / "a.nmea").read_bytes()).hexdigest()
     assert log["source"] == "a.nmea" and log["sigma_source"] == "stated" and log["attitude"] == "ground"
     assert n == 101
+    again = run(tmp_path / "s.toml", out=tmp_path / "b.h5")            # the fit is deterministic
+    with open_dataset(out) as a, open_dataset(again) as b:
+        for key in ("truth/pos_ecef", "truth/quat_nb", "truth/omega_ib_b", "truth/f_ib_b"):
+            assert np.array_equal(a[key][:], b[key][:])
 
 
 def test_a_long_gap_in_the_margin_outside_the_run_is_not_an_error(tmp_path):
