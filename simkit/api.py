@@ -246,3 +246,11 @@ def campaign(scenario, out, runs: int, **options) -> dict:
     from .campaign import run_campaign
 
     return run_campaign(scenario, out, runs, **options)
+
+
+def export(path, fmt: str, out, **options) -> list:
+    """Write the simkit file ``path`` as ``fmt`` ("rosbag2", "csv" or "kml") at ``out``; returns the written paths
+    (:func:`simkit.export.export`, its options; docs/logs_and_export.md)."""
+    from .export import export as _export
+
+    return _export(path, fmt, out, **options)

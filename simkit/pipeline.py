@@ -200,7 +200,10 @@ def _imu_rows(t, block) -> dict[str, np.ndarray]:
 
 
 def _write_static(w: Writer, sc: Scenario, stages: Stages) -> None:
-    w.group_attrs("truth", {"rate_hz": sc.trajectory.rate_hz})
+    truth_attrs = {"rate_hz": sc.trajectory.rate_hz}
+    if sc.trajectory.path is not None:      # a logged trajectory: which log, and what the fit found
+        truth_attrs["log"] = sc.trajectory.path.summary()
+    w.group_attrs("truth", truth_attrs)
     if stages.imu is not None:
         w.group_attrs("imu", dict(stages.imu.attributes(), rate_hz=sc.trajectory.rate_hz))
     if stages.gnss is not None:

@@ -169,6 +169,7 @@ LAYERS = [
     {"trajectory", "imu", "constellation"},
     {"gnss"},
     {"io"},
+    {"logs"},
     {"scenario"},
     {"pipeline"},
     {"validation"},
@@ -176,6 +177,7 @@ LAYERS = [
     {"attitude"},
     {"estimators"},
     {"referee"},
+    {"export"},
     {"plots"},
     {"campaign"},
     {"api"},
@@ -184,7 +186,8 @@ LAYERS = [
     {"__main__"},
 ]
 # third-party packages only these sub-packages may import (None: none of simkit): the wheel runs without them
-CONFINED = {"pyins": None, "pandas": None, "matplotlib": "plots", "dask": "campaign", "distributed": "campaign"}
+CONFINED = {"pyins": None, "pandas": None, "matplotlib": "plots", "dask": "campaign", "distributed": "campaign",
+            "rosbags": "export"}
 
 
 def _package_edges():

@@ -151,7 +151,9 @@ _CAMPAIGN = [
 SCHEMA: tuple[Field, ...] = tuple(_TRUTH + _IMU + _GNSS + _SOLUTIONS + _CAMPAIGN)
 
 GROUP_ATTRS = {
-    "truth": {"rate_hz": "trajectory.rate_hz"},
+    "truth": {"rate_hz": "trajectory.rate_hz",
+              "log": "a logged trajectory only (trajectory.source): JSON of source, sha256, samples_used, attitude, "
+                     "sigma_m, sigma_source, residual_rms_m"},
     "imu": {"rate_hz": "IMU rate", "<parameter>": "the IMU error model parameters (JSON text where not scalar)"},
     "gnss": {"rate_hz": "gnss.rate_hz"},
     "solutions/<name>": {"config": "the estimator configuration, JSON"},

@@ -129,7 +129,7 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
     try:
         for item in overrides:
             apply_override(data, item)
-        sc = _validate(data)
+        sc = _validate(data, None if isinstance(scenario, dict) else path.parent)
     except ScenarioError as exc:
         raise exc.with_source(source) from None
     if text is None or overrides:
@@ -138,7 +138,7 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
     return replace(sc, text=text, source=source, data=data, overrides=tuple(overrides))
 
 
-def _validate(data: dict) -> Scenario:
+def _validate(data: dict, base: Path | None = None) -> Scenario:
     root = Section(data, "")
     meta = root.section("scenario", required=True)
     name = meta.get("name", str, check=lambda v: None if re.fullmatch(r"[\w.-]+", v) else
@@ -155,6 +155,10 @@ def _validate(data: dict) -> Scenario:
     week, sow = gpstime.utc_to_gps(start)
 
     traj = parse_trajectory(root.section("trajectory", required=True))
+    if traj.log is not None:   # a logged trajectory: read and fitted now, so a bad log is reported at load
+        from ..logs import fit_trajectory
+
+        traj = fit_trajectory(traj, base, start, week, sow, duration)
     imu = gnss = None
     if root.has("imu"):
         imu = parse_imu(root.section("imu"))

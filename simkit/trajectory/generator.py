@@ -15,7 +15,6 @@ dlon/dt = v_E / ((R_N + h) cos lat).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
 from typing import Iterator
 
 import numpy as np
@@ -24,37 +23,9 @@ from scipy.spatial.transform import Rotation
 from .. import earth, frames
 from ..earth import G0
 from .config import TrajectoryConfig
+from .truth import TrajectoryTruth, body_rate_nb
 
 CHANNELS = ("accel", "pitch_rate", "turn_rate", "turn_accel", "roll_rate")
-
-
-@dataclass(frozen=True)
-class TrajectoryTruth:
-    """A block of truth at the sample times ``t`` (s since start); one field per /truth dataset (README, "HDF5 layout")."""
-
-    t: np.ndarray
-    pos_ecef: np.ndarray
-    pos_lla: np.ndarray
-    vel_enu: np.ndarray
-    quat_nb: np.ndarray
-    euler: np.ndarray
-    omega_ib_b: np.ndarray
-    f_ib_b: np.ndarray
-
-    def __len__(self):
-        return len(self.t)
-
-    def arrays(self) -> dict[str, np.ndarray]:
-        """The fields by name (the arrays themselves, not copies)."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    def vel_ecef(self) -> np.ndarray:
-        """Velocity relative to Earth in ECEF axes, (N, 3) m/s."""
-        return frames.enu_to_ecef_vec(self.vel_enu, self.pos_lla[:, 0], self.pos_lla[:, 1])
-
-    def take(self, index) -> "TrajectoryTruth":
-        """The samples ``index`` (any numpy index along the time axis) of every field."""
-        return TrajectoryTruth(**{k: v[index] for k, v in self.arrays().items()})
 
 
 def _simpson_steps(f_nodes, f_mid, h):
@@ -102,6 +73,10 @@ class Trajectory:
         rate = float(rate_hz or self.cfg.rate_hz)
         h = 1.0 / rate
         n_total = self.n_samples(rate)
+        if self.cfg.path is not None:                       # a logged trajectory: evaluated, not integrated
+            for k0 in range(0, n_total, block_samples):
+                yield self.cfg.path.truth(np.arange(k0, min(n_total, k0 + block_samples)) * h)
+            return
         c = self.cfg
         state = np.array([c.speed_m_per_s, c.flight_path_rad, c.heading_rad, c.roll_rad, c.lat_rad, c.lon_rad, c.height_m])
         first = True
@@ -166,12 +141,7 @@ class Trajectory:
                    + (speed * psi_dot)[:, None] * np.stack([cg * cp, -cg * sp, np.zeros_like(t)], -1))
 
         rot = Rotation.from_quat(frames.quat_from_euler(gamma, roll, psi))
-        # w_nb^b for C = R_z(yaw) R_x(pitch) R_y(roll), yaw = -psi
-        yaw_dot = -psi_dot
-        cr, sr = np.cos(roll), np.sin(roll)
-        w_nb = np.stack([cr * gamma_dot - sr * cg * yaw_dot,
-                         sg * yaw_dot + roll_dot,
-                         sr * gamma_dot + cr * cg * yaw_dot], axis=-1)
+        w_nb = body_rate_nb(gamma, roll, gamma_dot, roll_dot, psi_dot)
         w_ie = earth.earth_rate_enu(lat)
         w_en = earth.transport_rate_enu(lat, hgt, vel_enu)
         omega_ib_b = w_nb + rot.inv().apply(w_ie + w_en)
