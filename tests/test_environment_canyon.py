@@ -1,0 +1,91 @@
+"""Street canyons against their closed forms, over a day of real GPS + BDS satellites seen from a static antenna.
+
+For a straight canyon of walls at lateral distances d1 (on the satellite's side, height H1) and d2 (the far side,
+height H2) from the antenna, with k = tan(el) / |sin(az - axis)| the rise per metre across the street:
+blocked direct path exactly when d1 k < H1; a reflection off the far wall's face exists when its point is below
+the top (d2 k < H2) and the incoming ray clears the near wall ((2 d2 + d1) k >= H1); its extra path is the image
+method's 2 d2 cos(el) |cos(az - wall normal)| = 2 d2 cos(el) |sin(az - axis)|. Both are checked to 1 mm: a state
+may differ only where the ray passes a wall's top within 1 mm.
+"""
+import numpy as np
+import pytest
+
+import simkit
+from simkit.io import open_dataset, read_gnss
+
+ORIGIN = {"lat_deg": 34.2, "lon_deg": 108.9, "height_m": 400.0}
+
+
+def day_scenario(canyon: dict, name="canyon_day", extra_env=None) -> dict:
+    env = {"canyon": canyon, "reflection_range_m": 30000.0}
+    env.update(extra_env or {})
+    return {"scenario": {"name": name, "start": "2026-04-27T00:00:00Z", "duration_s": 86000.0},
+            "trajectory": {"rate_hz": 0.01, "origin": ORIGIN,
+                           "segment": [{"kind": "static", "duration_s": 86000.0}]},
+            "gnss": {"rate_hz": 0.01, "elevation_mask_deg": 0.0, "signals": ["L1C", "B1I"],
+                     "constellation": [{"source": "BRDM00DLR_S_20261170000_01D_MN.rnx.gz"}],
+                     "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0]}]},
+            "environment": env}
+
+
+def los_of(path):
+    with open_dataset(path) as ds:
+        g = read_gnss(ds, truth=("los_state", "nlos_delay", "azimuth", "elevation"), satellites=False)
+    t = g.truth
+    return t["los_state"][:, 0], t["nlos_delay"][:, 0], t["azimuth"][:, 0], t["elevation"][:, 0]
+
+
+def closed_form(az, el, axis_deg, d_left, d_right, h_left, h_right, half_length):
+    """States and extra paths of the analytic canyon (antenna at the canyon's middle along the street)."""
+    delta = az - np.radians(axis_deg)
+    s = np.sin(delta)
+    left_side = s < 0                                 # the satellite is to the left of the street axis
+    d1, d2 = np.where(left_side, d_left, d_right), np.where(left_side, d_right, d_left)
+    h1, h2 = np.where(left_side, h_left, h_right), np.where(left_side, h_right, h_left)
+    with np.errstate(divide="ignore"):
+        k = np.tan(el) / np.abs(s)
+        cot = np.abs(np.cos(delta) / s)
+    direct = ~((d1 * k < h1) & (d1 * cot <= half_length))
+    refl = (d2 * k < h2) & ((2 * d2 + d1) * k >= h1) & (d2 * cot <= half_length)
+    state = np.where(direct, np.where(refl, 1, 0), np.where(refl, 2, 3))
+    extra = np.where(refl, 2 * d2 * np.cos(el) * np.abs(s), np.where(direct, 0.0, np.nan))
+    # how close each ray passes a wall's top (m): a state may differ within 1 mm of a top
+    margin = np.minimum.reduce([np.abs(d1 * k - h1), np.abs(d2 * k - h2), np.abs((2 * d2 + d1) * k - h1)])
+    return state, extra, margin
+
+
+def check(path, **geometry):
+    state, delay, az, el = los_of(path)
+    up = el > 0
+    assert (state[~up & np.isfinite(el)] == 255).all()
+    want, extra, margin = closed_form(az[up], el[up], **geometry)
+    got = state[up]
+    differ = got != want
+    assert not (differ & (margin > 1e-3)).any(), np.flatnonzero(differ & (margin > 1e-3))[:10]
+    same = ~differ
+    np.testing.assert_allclose(delay[up][same], extra[same], atol=1e-3, equal_nan=True)
+    return got
+
+
+@pytest.mark.slow
+def test_symmetric_canyon_blocks_and_reflects_as_the_closed_form(tmp_path):
+    """Antenna in the middle of a 20 m x 60 m canyon: direct above atan(H / d(az)), NLOS between that and
+    atan(H / 3 d(az)) off the far wall, blocked below; never both direct and reflected (the far wall's
+    reflection point is then above its top)."""
+    canyon = {"width_m": 20.0, "height_m": 60.0, "azimuth_deg": 30.0, "length_m": 40000.0}
+    out = simkit.run(day_scenario(canyon), out=tmp_path / "sym.h5")
+    got = check(out, axis_deg=30.0, d_left=10.0, d_right=10.0, h_left=60.0, h_right=60.0, half_length=20000.0)
+    counts = np.bincount(got, minlength=4)
+    assert counts[0] > 100 and counts[2] > 100 and counts[3] > 100 and counts[1] == 0
+
+
+@pytest.mark.slow
+def test_off_centre_asymmetric_canyon_has_direct_plus_reflected(tmp_path):
+    """Antenna 4 m left of the axis of a 24 m canyon with a 25 m left and 70 m right wall (east-west street)."""
+    axis = 90.0
+    left = np.array([-np.cos(np.radians(axis)), np.sin(np.radians(axis))])
+    canyon = {"width_m": 24.0, "left_height_m": 25.0, "right_height_m": 70.0, "azimuth_deg": axis,
+              "length_m": 40000.0, "centre_en_m": (-4.0 * left).tolist()}
+    out = simkit.run(day_scenario(canyon), out=tmp_path / "asym.h5")
+    got = check(out, axis_deg=axis, d_left=8.0, d_right=16.0, h_left=25.0, h_right=70.0, half_length=20000.0)
+    assert (np.bincount(got, minlength=4) > 20).all()
