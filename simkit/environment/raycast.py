@@ -105,12 +105,72 @@ def blocked(ox, oy, oz, dx, dy, tan_el, t_max, exclude, x0, y0, cell, nx, ny, st
             return False
 
 
+@numba.njit(cache=True)
+def _near_walls(px, py, range_m, x0, y0, cell, nx, ny, start, cell_walls, stamp, mark, near):
+    """Fill ``near`` with the walls in the cells within ``range_m`` of (px, py) (each once, using ``stamp``
+    marked with ``mark``); returns their number."""
+    n_near = 0
+    i0 = max(int(math.floor((px - range_m - x0) / cell)), 0)
+    i1 = min(int(math.floor((px + range_m - x0) / cell)), nx - 1)
+    j0 = max(int(math.floor((py - range_m - y0) / cell)), 0)
+    j1 = min(int(math.floor((py + range_m - y0) / cell)), ny - 1)
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
+            k = i * ny + j
+            for q in range(start[k], start[k + 1]):
+                w = cell_walls[q]
+                if stamp[w] != mark:
+                    stamp[w] = mark
+                    near[n_near] = w
+                    n_near += 1
+    return n_near
+
+
+@numba.njit(cache=True)
+def _best_reflection(px, py, pz, sa, ca, ce, se, near, n_near, range_m, x0, y0, cell, nx, ny, start,
+                     cell_walls, ax, ay, bx, by, top, z_top):
+    """The wall (-1 for none) and extra path (m) of the shortest valid reflection among the walls ``near``."""
+    te = se / ce
+    best, best_w = _INF, -1
+    for q in range(n_near):
+        w = near[q]
+        ex, ey = bx[w] - ax[w], by[w] - ay[w]
+        length = math.sqrt(ex * ex + ey * ey)
+        nx_, ny_ = ey / length, -ex / length
+        d = nx_ * (px - ax[w]) + ny_ * (py - ay[w])
+        if d < 0.0:
+            nx_, ny_, d = -nx_, -ny_, -d
+        nu = ce * (nx_ * sa + ny_ * ca)               # n . u
+        if d <= _EPS_T or nu <= 0.0:
+            continue
+        ext = 2.0 * d * nu
+        if ext >= best:
+            continue
+        s = d / nu                                    # antenna -> Q along u'
+        hx, hy = ce * sa - 2.0 * nu * nx_, ce * ca - 2.0 * nu * ny_   # horizontal part of u'
+        qx, qy, qz = px + s * hx, py + s * hy, pz + s * se
+        if qz >= top[w] or s * ce > range_m:
+            continue
+        lam = ((qx - ax[w]) * ex + (qy - ay[w]) * ey) / (length * length)
+        if lam < 0.0 or lam > 1.0:
+            continue
+        if blocked(px, py, pz, hx / ce, hy / ce, te, s * ce, w, x0, y0, cell, nx, ny, start, cell_walls,
+                   ax, ay, bx, by, top, z_top):
+            continue
+        if blocked(qx, qy, qz, sa, ca, te, _INF, w, x0, y0, cell, nx, ny, start, cell_walls, ax, ay, bx, by,
+                   top, z_top):
+            continue
+        best, best_w = ext, w
+    return best_w, best
+
+
 @numba.njit(cache=True, parallel=True)
 def trace(pos, az, el, x0, y0, cell, nx, ny, start, cell_walls, ax, ay, bx, by, top, range_m, reflections):
     """Direct blocking and the best reflection for antennas at ``pos`` (M, A, 3) m and satellites at ``az``,
     ``el`` (M, A, C) rad. Returns ``direct_blocked`` (M, A, C) bool, ``wall`` (M, A, C) int64 (the reflecting
     wall, -1 for none) and ``extra`` (M, A, C) m (the reflected path's extra length, NaN for none). Rays with a
-    non-finite or non-positive elevation are left unblocked without reflection."""
+    non-finite or non-positive elevation are left unblocked without reflection. Epochs run in parallel; each
+    result depends on its own ray only, so the output does not depend on the thread count."""
     m_n, a_n, c_n = az.shape
     w_n = top.size
     z_top = top.max() if w_n else -_INF
@@ -124,60 +184,19 @@ def trace(pos, az, el, x0, y0, cell, nx, ny, start, cell_walls, ax, ay, bx, by, 
             px, py, pz = pos[m, a, 0], pos[m, a, 1], pos[m, a, 2]
             n_near = 0
             if reflections and pz < z_top:
-                i0 = max(int(math.floor((px - range_m - x0) / cell)), 0)
-                i1 = min(int(math.floor((px + range_m - x0) / cell)), nx - 1)
-                j0 = max(int(math.floor((py - range_m - y0) / cell)), 0)
-                j1 = min(int(math.floor((py + range_m - y0) / cell)), ny - 1)
-                for i in range(i0, i1 + 1):
-                    for j in range(j0, j1 + 1):
-                        k = i * ny + j
-                        for q in range(start[k], start[k + 1]):
-                            w = cell_walls[q]
-                            if stamp[w] != a + 1:
-                                stamp[w] = a + 1
-                                near[n_near] = w
-                                n_near += 1
+                n_near = _near_walls(px, py, range_m, x0, y0, cell, nx, ny, start, cell_walls, stamp, a + 1, near)
             for c in range(c_n):
                 e = el[m, a, c]
                 if not (e > 0.0):
                     continue
                 sa, ca = math.sin(az[m, a, c]), math.cos(az[m, a, c])
                 ce, se = math.cos(e), math.sin(e)
-                te = se / ce
-                direct[m, a, c] = blocked(px, py, pz, sa, ca, te, _INF, -1, x0, y0, cell, nx, ny, start,
+                direct[m, a, c] = blocked(px, py, pz, sa, ca, se / ce, _INF, -1, x0, y0, cell, nx, ny, start,
                                           cell_walls, ax, ay, bx, by, top, z_top)
-                best = _INF
-                best_w = -1
-                for q in range(n_near):
-                    w = near[q]
-                    ex, ey = bx[w] - ax[w], by[w] - ay[w]
-                    length = math.sqrt(ex * ex + ey * ey)
-                    nx_, ny_ = ey / length, -ex / length
-                    d = nx_ * (px - ax[w]) + ny_ * (py - ay[w])
-                    if d < 0.0:
-                        nx_, ny_, d = -nx_, -ny_, -d
-                    nu = ce * (nx_ * sa + ny_ * ca)               # n . u
-                    if d <= _EPS_T or nu <= 0.0:
-                        continue
-                    ext = 2.0 * d * nu
-                    if ext >= best:
-                        continue
-                    s = d / nu                                    # antenna -> Q along u'
-                    hx, hy = ce * sa - 2.0 * nu * nx_, ce * ca - 2.0 * nu * ny_   # horizontal part of u'
-                    qx, qy, qz = px + s * hx, py + s * hy, pz + s * se
-                    if qz >= top[w] or s * ce > range_m:
-                        continue
-                    lam = ((qx - ax[w]) * ex + (qy - ay[w]) * ey) / (length * length)
-                    if lam < 0.0 or lam > 1.0:
-                        continue
-                    if blocked(px, py, pz, hx / ce, hy / ce, te, s * ce, w, x0, y0, cell, nx, ny, start,
-                               cell_walls, ax, ay, bx, by, top, z_top):
-                        continue
-                    if blocked(qx, qy, qz, sa, ca, te, _INF, w, x0, y0, cell, nx, ny, start, cell_walls,
-                               ax, ay, bx, by, top, z_top):
-                        continue
-                    best, best_w = ext, w
-                if best_w >= 0:
-                    wall[m, a, c] = best_w
-                    extra[m, a, c] = best
+                if n_near:
+                    w, ext = _best_reflection(px, py, pz, sa, ca, ce, se, near, n_near, range_m, x0, y0, cell,
+                                              nx, ny, start, cell_walls, ax, ay, bx, by, top, z_top)
+                    if w >= 0:
+                        wall[m, a, c] = w
+                        extra[m, a, c] = ext
     return direct, wall, extra
