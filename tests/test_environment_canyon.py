@@ -89,3 +89,30 @@ def test_off_centre_asymmetric_canyon_has_direct_plus_reflected(tmp_path):
     out = simkit.run(day_scenario(canyon), out=tmp_path / "asym.h5")
     got = check(out, axis_deg=axis, d_left=8.0, d_right=16.0, h_left=25.0, h_right=70.0, half_length=20000.0)
     assert (np.bincount(got, minlength=4) > 20).all()
+
+
+def test_one_geojson_building_reproduces_the_canyon_wall(tmp_path):
+    """A 400 m x 20 m building, 60 m high, whose street face is the right wall of a one-sided canyon (written as
+    longitude/latitude by pymap3d): the same state and extra path for every satellite over six hours."""
+    import json
+
+    import pymap3d
+
+    axis = np.radians(30.0)
+    along, left = np.array([np.sin(axis), np.cos(axis)]), np.array([-np.cos(axis), np.sin(axis)])
+    corners = [a * 200.0 * along + lat * left for a, lat in ((-1, -10), (1, -10), (1, -30), (-1, -30), (-1, -10))]
+    lat, lon, _ = pymap3d.enu2geodetic(np.array([c[0] for c in corners]), np.array([c[1] for c in corners]), 0.0,
+                                       ORIGIN["lat_deg"], ORIGIN["lon_deg"], ORIGIN["height_m"])
+    feature = {"type": "Feature", "properties": {"height": 60.0},
+               "geometry": {"type": "Polygon", "coordinates": [np.stack([lon, lat], axis=1).tolist()]}}
+    (tmp_path / "one.geojson").write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    short = {"scenario.duration_s": 21600.0, "trajectory.segment[0].duration_s": 21600.0}
+    canyon = {"width_m": 20.0, "left_height_m": 0.0, "right_height_m": 60.0, "azimuth_deg": 30.0,
+              "length_m": 400.0}
+    a = los_of(simkit.run(day_scenario(canyon), out=tmp_path / "canyon.h5", overrides=short))
+    building = day_scenario(canyon)
+    building["environment"] = {"buildings": str(tmp_path / "one.geojson")}
+    b = los_of(simkit.run(building, out=tmp_path / "building.h5", overrides=short))
+    assert set(np.unique(a[0])) >= {0, 1, 3, 255}   # one wall: blocked, or direct with or without its reflection
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_allclose(a[1], b[1], atol=1e-3, equal_nan=True)
