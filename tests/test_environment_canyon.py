@@ -116,3 +116,34 @@ def test_one_geojson_building_reproduces_the_canyon_wall(tmp_path):
     assert set(np.unique(a[0])) >= {0, 1, 3, 255}   # one wall: blocked, or direct with or without its reflection
     np.testing.assert_array_equal(a[0], b[0])
     np.testing.assert_allclose(a[1], b[1], atol=1e-3, equal_nan=True)
+
+
+def test_body_mask_table_and_box_on_a_level_vehicle(tmp_path):
+    """A level vehicle heading north (body x east, y north, z up): a mask table of 25 deg ahead (|body azimuth|
+    < 90 deg) and 5 deg behind blocks exactly those elevations; a box 1 m north of the second antenna, 2 m above
+    it and 200 m wide (a wall in the body frame) blocks exactly when tan(el) < 2 cos(az) (crossing its face,
+    y = 1 m, below its top)."""
+    sc = day_scenario({"width_m": 10.0, "height_m": 1.0})
+    sc["gnss"]["antenna"] = [{"lever_arm_m": [0.0, 0.0, 0.0]}, {"lever_arm_m": [0.0, 0.0, 1.0]}]
+    sc["environment"] = {"body_mask": [{"azimuth_deg": [0.0, 89.999, 90.0, 270.0, 270.001],
+                                        "elevation_deg": [25.0, 25.0, 5.0, 5.0, 25.0], "antennas": [0]}],
+                         "body_box": [{"min_m": [-100.0, 1.0, -100.0], "max_m": [100.0, 1.1, 3.0],
+                                       "antennas": [1]}]}
+    out = simkit.run(sc, out=tmp_path / "body.h5",
+                     overrides={"scenario.duration_s": 21600.0, "trajectory.segment[0].duration_s": 21600.0})
+    with open_dataset(out) as ds:
+        g = read_gnss(ds, truth=("los_state", "azimuth", "elevation"), satellites=False)
+    state, az, el = g.truth["los_state"], g.truth["azimuth"], g.truth["elevation"]
+    up = el > 0
+    ahead = np.cos(az) > 0
+    mask = np.where(ahead, np.radians(25.0), np.radians(5.0))
+    edge = np.abs(np.cos(az)) < 2e-5                  # the table's 0.001 deg ramps at +-90 deg
+    want0 = np.where(el[:, 0] < mask[:, 0], 3, 0)
+    ok0 = up[:, 0] & ~edge[:, 0] & (np.abs(el[:, 0] - mask[:, 0]) > 1e-9)
+    np.testing.assert_array_equal(state[:, 0][ok0], want0[ok0])
+    with np.errstate(divide="ignore"):
+        rise = np.where(ahead[:, 1], np.tan(el[:, 1]) / np.cos(az[:, 1]), np.inf)   # per metre northwards
+    want1 = np.where(rise < 2.0, 3, 0)
+    ok1 = up[:, 1] & (np.abs(rise - 2.0) > 1e-6)
+    np.testing.assert_array_equal(state[:, 1][ok1], want1[ok1])
+    assert (want0[ok0] == 3).sum() > 50 and (want1[ok1] == 3).sum() > 50
