@@ -9,7 +9,7 @@ frame for the direct line of sight and for the arrival direction of the reflecti
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -111,3 +111,16 @@ class Environment:
         sign = np.where(d < 0, -1.0, 1.0)
         ok = wall >= 0
         return np.where(ok[..., None], n * sign[..., None], 0.0), np.where(ok, d * sign, 0.0)
+
+    def static(self, site_ecef, az, el) -> LineOfSight:
+        """The states seen by a fixed antenna at ``site_ecef`` (3,) m towards satellites at azimuth ``az`` and
+        elevation ``el`` (T, S) rad (body masks do not apply: there is no vehicle)."""
+        t_n, s_n = np.shape(az)
+        pos = np.broadcast_to(np.asarray(site_ecef, dtype=float), (t_n, 1, 3))
+        lla = np.broadcast_to(frames.ecef_to_lla(np.asarray(site_ecef, dtype=float)[None])[0], (t_n, 1, 3))
+        zeros = np.zeros((t_n, 1, s_n))
+        body_free = Environment.__new__(Environment)
+        body_free.__dict__.update(self.__dict__)
+        body_free.cfg = replace(self.cfg, mask_tables=(), boxes=())
+        return body_free.classify(pos, lla, np.zeros((t_n, 1, 3)), np.zeros((t_n, 1, s_n, 3)), np.asarray(az)[:, None],
+                                  np.asarray(el)[:, None], zeros, zeros, np.broadcast_to(np.eye(3), (t_n, 3, 3)))
