@@ -41,10 +41,10 @@ def one(label, scenario, d: Path, seed: int):
     from cli_errors import run_cli
 
     h5 = simkit.run(scenario, out=d / f"{label}.h5", seed=seed)
-    simkit.solve(h5, ["spp", "kf15"])
+    sols = simkit.solve(h5, ["spp", "kf15"])
     out = {}
     for name in ("spp", "kf15"):
-        sc = simkit.score(h5, h5, solution=name)
+        sc = simkit.score(h5, sols[name])
         out[name] = {"all": sc.statistics["horizontal"]["rms"], "3d": sc.statistics["position_3d"]["rms"],
                      **{k: v["statistics"]["horizontal"]["rms"] for k, v in sc.by_state.items()},
                      "epochs": {k: v["epochs"] for k, v in sc.by_state.items()}}
