@@ -9,7 +9,7 @@ frame for the direct line of sight and for the arrival direction of the reflecti
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -58,15 +58,16 @@ class Environment:
         en = np.einsum("ij,maj->mai", self.c_en[:2], ant_pos_ecef - self.origin_ecef)
         return np.concatenate([en, ant_lla[..., 2:3] - self.h0], axis=-1)
 
-    def classify(self, ant_pos_ecef, lla, vel_enu, los_ecef, az, el, az_rate, el_rate, c_be) -> LineOfSight:
+    def classify(self, ant_pos_ecef, lla, vel_enu, los_ecef, az, el, az_rate, el_rate, c_be,
+                 body: bool = True) -> LineOfSight:
         """The line-of-sight state of antennas at ``ant_pos_ecef`` (M, A, 3) m (geodetic ``lla`` (M, A, 3),
         velocity ``vel_enu`` (M, A, 3) m/s) towards satellites along unit vectors ``los_ecef`` (M, A, C, 3) at
         azimuth ``az`` and elevation ``el`` (M, A, C) rad with rates ``az_rate``, ``el_rate`` rad/s; ``c_be``
-        (M, 3, 3) body -> ECEF."""
+        (M, 3, 3) body -> ECEF; ``body`` False leaves the body masks out."""
         pos = np.ascontiguousarray(self.local(ant_pos_ecef, lla))
         g = self.grid
         az_c = np.ascontiguousarray(np.nan_to_num(az, nan=0.0))
-        el_c = np.ascontiguousarray(np.where(np.isfinite(el), el, -1.0))
+        el_c = np.ascontiguousarray(np.where(np.isfinite(el), np.minimum(el, np.pi / 2 - 1e-9), -1.0))
         direct, wall, extra = trace(pos, az_c, el_c, g.x0, g.y0, g.cell, g.nx, g.ny, g.start, g.walls,
                                     self.ax, self.ay, self.bx, self.by, self.top, self.cfg.reflection_range_m,
                                     self.cfg.reflections)
@@ -74,7 +75,7 @@ class Environment:
         n, d = self._normal(wall, pos)                                         # (M, A, C, 2), (M, A, C)
         sa, ca, se, ce = np.sin(az_c), np.cos(az_c), np.sin(el_c), np.cos(el_c)
         nu = ce * (n[..., 0] * sa + n[..., 1] * ca)
-        if self.cfg.mask_tables or self.cfg.boxes:
+        if body and (self.cfg.mask_tables or self.cfg.boxes):
             c_eb = np.swapaxes(c_be, -1, -2)
             direct |= body_blocked(self.cfg.mask_tables, self.cfg.boxes, self.lever_b,
                                    np.einsum("mij,macj->maci", c_eb, los_ecef))
@@ -119,8 +120,6 @@ class Environment:
         pos = np.broadcast_to(np.asarray(site_ecef, dtype=float), (t_n, 1, 3))
         lla = np.broadcast_to(frames.ecef_to_lla(np.asarray(site_ecef, dtype=float)[None])[0], (t_n, 1, 3))
         zeros = np.zeros((t_n, 1, s_n))
-        body_free = Environment.__new__(Environment)
-        body_free.__dict__.update(self.__dict__)
-        body_free.cfg = replace(self.cfg, mask_tables=(), boxes=())
-        return body_free.classify(pos, lla, np.zeros((t_n, 1, 3)), np.zeros((t_n, 1, s_n, 3)), np.asarray(az)[:, None],
-                                  np.asarray(el)[:, None], zeros, zeros, np.broadcast_to(np.eye(3), (t_n, 3, 3)))
+        return self.classify(pos, lla, np.zeros((t_n, 1, 3)), np.zeros((t_n, 1, s_n, 3)), np.asarray(az)[:, None],
+                             np.asarray(el)[:, None], zeros, zeros, np.broadcast_to(np.eye(3), (t_n, 3, 3)),
+                             body=False)
