@@ -37,17 +37,22 @@ def moving_base(rover, base, nav, out):
     return np.array([int(r[5]) for r in rows]), np.array([[float(x) for x in r[2:5]] for r in rows])
 
 
-def one(label, scenario, d: Path, seed: int):
+def one(label, scenario, d: Path, seed: int, classes_from=None):
+    """Run, solve, score and RTKLIB on one scenario; the epochs are classed by the line-of-sight states of the
+    file ``classes_from`` (default: this run's own file)."""
     from cli_errors import run_cli
+    from simkit.referee import stats
+    from simkit.referee.line_of_sight import by_state
 
     h5 = simkit.run(scenario, out=d / f"{label}.h5", seed=seed)
     sols = simkit.solve(h5, ["spp", "kf15"])
     out = {}
     for name in ("spp", "kf15"):
         sc = simkit.score(h5, sols[name])
+        classes = by_state(classes_from or h5, sc.errors, stats.series(sc.errors))
         out[name] = {"all": sc.statistics["horizontal"]["rms"], "3d": sc.statistics["position_3d"]["rms"],
-                     **{k: v["statistics"]["horizontal"]["rms"] for k, v in sc.by_state.items()},
-                     "epochs": {k: v["epochs"] for k, v in sc.by_state.items()}}
+                     **{k: v["statistics"]["horizontal"]["rms"] for k, v in classes.items()},
+                     "epochs": {k: v["epochs"] for k, v in classes.items()}}
     assert run_cli(["rinex", str(h5), "-o", str(d / f"rnx_{label}")], d).returncode == 0
     rnx = d / f"rnx_{label}"
     q, b = moving_base(next(rnx.glob("*ant1.rnx")), next(rnx.glob("*ant0.rnx")), next(rnx.glob("BRDM*.rnx")),
@@ -56,7 +61,7 @@ def one(label, scenario, d: Path, seed: int):
         n_epochs = ds["gnss/t"].shape[0]
     out["rtklib"] = {"fixed": float(np.sum(q == 1) / n_epochs), "epochs_out": int(q.size),
                      "wrong": int(np.sum(np.abs(np.linalg.norm(b[q == 1], axis=1) - 2.0) > 0.05))}
-    return out
+    return out, h5
 
 
 def main():
@@ -66,7 +71,9 @@ def main():
     urban = tomllib.loads(resolve("urban_canyon").read_text())
     open_sky = {k: v for k, v in urban.items() if k != "environment"}
     with tempfile.TemporaryDirectory() as d:
-        res = {label: one(label, sc, Path(d), args.seed) for label, sc in (("urban", urban), ("open", open_sky))}
+        res = {}
+        res["urban"], urban_h5 = one("urban", urban, Path(d), args.seed)
+        res["open"], _ = one("open", open_sky, Path(d), args.seed, classes_from=urban_h5)   # the urban epochs' classes
     for label, r in res.items():
         for name in ("spp", "kf15"):
             x = r[name]
