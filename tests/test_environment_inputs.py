@@ -104,3 +104,41 @@ def test_geojson_multipolygon_and_string_heights():
         p.write_text(json.dumps(doc))
         feet = read_footprints(p)
     assert len(feet) == 2 and all(f.height_m == 12.0 for f in feet)
+
+
+def test_a_route_of_canyons_and_buildings_beside_the_scenario(tmp_path):
+    """[[environment.canyon]] tables give two walls each at the stated offsets; a relative GeoJSON path is taken
+    from the scenario's folder, with height_offset_m added to its heights."""
+    import numpy as np
+
+    from simkit.scenario import load
+
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "city.geojson").write_text(json.dumps({"type": "FeatureCollection",
+                                                                "features": [feature(height=30.0)]}))
+    text = BASE + """
+[environment]
+buildings = "city.geojson"
+height_offset_m = -1.5
+[[environment.canyon]]
+width_m = 20.0
+height_m = 40.0
+azimuth_deg = 90.0
+length_m = 100.0
+[[environment.canyon]]
+width_m = 16.0
+left_height_m = 10.0
+right_height_m = 0.0
+centre_en_m = [100.0, 50.0]
+"""
+    (tmp_path / "sub" / "s.toml").write_text(text)
+    env = load(tmp_path / "sub" / "s.toml").environment
+    w = env.walls
+    assert w.top.tolist() == [28.5] * 4 + [40.0, 40.0, 10.0]
+    # the east-west canyon: walls 10 m north and south of the origin, from x = -50 to 50
+    np.testing.assert_allclose(w.a[4:6], [[-50.0, 10.0], [-50.0, -10.0]], atol=1e-12)
+    np.testing.assert_allclose(w.b[4:6], [[50.0, 10.0], [50.0, -10.0]], atol=1e-12)
+    # the northward canyon at (100, 50): only its left (west) wall, 8 m west of the axis, 1000 m long
+    np.testing.assert_allclose(w.a[6], [92.0, -450.0], atol=1e-12)
+    np.testing.assert_allclose(w.b[6], [92.0, 550.0], atol=1e-12)
+    assert env.n_canyons == 2 and env.buildings == "city.geojson"
