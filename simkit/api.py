@@ -188,7 +188,7 @@ def score_labelled(path, estimate, spec=None, solution=None, point=None):
     finite = np.asarray(sol.t, dtype=float)[np.isfinite(sol.t)]
     span = (finite.min(), finite.max()) if finite.size else (None, None)
     truth = referee.read_truth(path, *span)    # only the truth the estimate needs
-    return referee.score(truth, sol, spec, where=str(label if sol is estimate else estimate)), label
+    return referee.score(truth, sol, spec, where=str(label if sol is estimate else estimate), path=path), label
 
 
 def check_validate(n_random: int, random_stride: int) -> None:

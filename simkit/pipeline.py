@@ -14,6 +14,7 @@ import numpy as np
 
 from . import gpstime
 from .constellation import NoStateError, Sky, load_sky
+from .environment import Environment
 from .errors import DataFileError, OutputError, ScenarioError
 from .gnss import GnssSimulator
 from .imu import ImuSimulator
@@ -108,7 +109,12 @@ def build(sc: Scenario, sky: Sky | None = None) -> Stages:
     if sc.gnss is not None:
         sky = sky if sky is not None else _sky(sc)
         _check_sky_covers_run(sc, sky, next(traj.blocks(block_samples=1)).pos_ecef[0])
-        gnss = GnssSimulator(sc.gnss, sky, sc.start_week, sc.start_sow, sc.seed, sc.duration_s)
+        env = None
+        if sc.environment is not None:
+            tr = sc.trajectory
+            env = Environment(sc.environment, (tr.lat_rad, tr.lon_rad, tr.height_m),
+                              np.array([a.lever_arm_b for a in sc.gnss.antennas]))
+        gnss = GnssSimulator(sc.gnss, sky, sc.start_week, sc.start_sow, sc.seed, sc.duration_s, env)
     return Stages(traj, imu, gnss)
 
 
@@ -170,7 +176,7 @@ def _check_sky_covers_run(sc: Scenario, sky: Sky, origin: np.ndarray) -> None:
 
 def _rows(prefix: str, obj) -> dict[str, np.ndarray]:
     """Dataset path -> array for every field of a stage's dataclass."""
-    return {f"{prefix}/{f.name}": getattr(obj, f.name) for f in fields(obj)}
+    return {f"{prefix}/{f.name}": getattr(obj, f.name) for f in fields(obj) if getattr(obj, f.name) is not None}
 
 
 def gnss_rows(ep, prefix: str = "gnss/") -> dict[str, np.ndarray]:

@@ -166,7 +166,7 @@ def test_package_import_graph_is_acyclic():
 LAYERS = [
     {"errors", "version", "atomic", "rng", "gpstime", "processes", "earth", "solution", "quat"},
     {"frames", "section", "params"},
-    {"trajectory", "imu", "constellation"},
+    {"trajectory", "imu", "constellation", "environment"},
     {"gnss"},
     {"io"},
     {"logs"},

@@ -42,6 +42,11 @@ def add_parser(sub):
     p.add_argument("--validity-days", type=float, default=None,
                    help="almanac/TLE sources: days either side of their epoch with valid states (default 7)")
     p.add_argument("--plot", metavar="OUT.png", help="save a sky plot (needs matplotlib: the 'plot' extra)")
+    p.add_argument("--environment", metavar="FILE.toml",
+                   help="a TOML file with an [environment] table (a scenario): the site sees its buildings and "
+                        "canyons, placed around the file's trajectory.origin (else around the site); the table "
+                        "gains counts of direct, direct+reflected, NLOS and blocked satellites, DOPs use the "
+                        "received ones and the plot marks each state")
     p.add_argument("--force", action="store_true",
                    help=f"compute even when the span needs more than {MEMORY_LIMIT_BYTES / 1024**3:g} GiB")
     return p
@@ -61,14 +66,21 @@ def run(args) -> int:
     week, sow0 = gpstime.utc_to_gps(start)
     sow = sow0 + np.arange(_step_count(args, len(const))) * args.step
     const.require_states(week, sow)  # NoStateError: names the source and the span it covers
+    env = _environment(args) if args.environment else None
     geo, vis, d = _compute(const, args, week, sow)
+    states = None
+    if env is not None:
+        states = _states(env, args, geo, vis)
+        vis = vis & (states <= 2)
+        d = sc.dops(np.where(vis, geo.elevation, np.nan), geo.azimuth, np.radians(args.mask), const.system)
     out = _Output()
-    _print_table(out, const, args, week, sow, vis, d)
+    _print_table(out, const, args, week, sow, vis, d, states)
     if args.plot:
         from ..plots import sky_figure
 
-        sky_figure(args.plot, plot_format, const, geo, vis,
-                   f"{const.source} from {args.lat:.2f}, {args.lon:.2f}, {args.start}")
+        sky_figure(args.plot, plot_format, const, geo, vis if states is None else np.isfinite(geo.elevation) & (
+            geo.elevation >= np.radians(args.mask)), f"{const.source} from {args.lat:.2f}, {args.lon:.2f}, "
+            f"{args.start}", states)
         out.line(f"sky plot written to {args.plot}")
     return 0
 
@@ -152,23 +164,72 @@ def _compute(const, args, week, sow):
     return geo, vis, sc.dops(geo.elevation, geo.azimuth, mask, const.system)
 
 
+def _environment(args):
+    """The :class:`simkit.environment.Environment` of the ``--environment`` file, around its trajectory origin
+    (else the site)."""
+    import tomllib
+
+    from ..environment import Environment, parse_config
+    from ..section import Section
+
+    path = Path(args.environment)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise ScenarioError("--environment", f"{path}: cannot read: {exc.strerror or exc}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ScenarioError("--environment", f"{path}: not valid TOML: {exc}") from None
+    if not isinstance(data.get("environment"), dict):
+        raise ScenarioError("--environment", f"{path}: no [environment] table")
+    origin = data.get("trajectory", {}).get("origin") if isinstance(data.get("trajectory"), dict) else None
+    try:
+        if isinstance(origin, dict):
+            o = Section(origin, "trajectory.origin")
+            lla = (np.radians(o.get("lat_deg", float)), np.radians(o.get("lon_deg", float)), o.get("height_m", float))
+        else:
+            lla = (np.radians(args.lat), np.radians(args.lon), args.height)
+        return Environment(parse_config(Section(data["environment"], "environment"), lla, path.parent), lla,
+                           np.zeros((1, 3)))
+    except ScenarioError as exc:
+        raise exc.with_source(str(path)) from None
+
+
+def _states(env, args, geo, vis):
+    """Line-of-sight states (T, S) of the site's satellites above the mask (255 for the others)."""
+    from .. import frames
+
+    rx = frames.lla_to_ecef(np.radians(args.lat), np.radians(args.lon), args.height)
+    el = np.where(np.isfinite(geo.elevation), geo.elevation, -1.0)
+    st = env.static(rx, np.nan_to_num(geo.azimuth), el).state[:, 0]
+    return np.where(vis, st, 255).astype(np.uint8)
+
+
 def _utc(week, sow) -> str:
     from .. import gpstime
 
     return gpstime.gps_to_utc(week, sow).strftime("%Y-%m-%d %H:%M:%S UTC")
 
 
-def _print_table(out, const, args, week, sow, vis, d):
+def _print_table(out, const, args, week, sow, vis, d, states=None):
     out.line(f"{const.source}: {len(const)} satellites ({const.kind}); site {args.lat:.4f}, {args.lon:.4f}, "
              f"{args.height:g} m; mask {args.mask:g} deg; one receiver clock per system")
+    if states is not None:
+        out.line(f"environment {args.environment}: counts above the mask are received ones (direct, direct+"
+                 "reflected, NLOS); dir d+r nlos blk split them by line-of-sight state")
     systems = sorted(set(const.system.tolist()))
-    out.line("UTC                  " + " ".join(f"{s:>3}" for s in systems) + "  all   GDOP   PDOP   HDOP   VDOP")
+    out.line("UTC                  " + " ".join(f"{s:>3}" for s in systems) + "  all   GDOP   PDOP   HDOP   VDOP"
+             + ("  dir d+r nlos blk" if states is not None else ""))
+    above = None if states is None else states != 255
     for m in range(sow.size):
         if out.closed:
             return
         counts = " ".join(f"{int(vis[m, const.system == s].sum()):3d}" for s in systems)
+        extra = ""
+        if states is not None:
+            extra = "  " + " ".join(f"{int(((states[m] == k) & above[m]).sum()):3d}" for k in range(3)) + \
+                f" {int(((states[m] == 3) & above[m]).sum()):3d}"
         out.line(f"{_utc(week, sow[m])[:19]}  {counts}  {int(vis[m].sum()):3d} "
-                 + " ".join(f"{d[k][m]:6.2f}" for k in "GPHV"))
+                 + " ".join(f"{d[k][m]:6.2f}" for k in "GPHV") + extra)
 
 
 class _Output:

@@ -56,6 +56,7 @@ class SignalTruth:
     sigma_code: np.ndarray
     sigma_carrier: np.ndarray
     sigma_doppler: np.ndarray
+    multipath_rate: np.ndarray | None = None   # with an [environment]: rate of multipath_carrier in the Doppler
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,8 @@ class GnssTruth:
     satellite_clock_drift: np.ndarray
     troposphere: np.ndarray
     troposphere_rate: np.ndarray
+    los_state: np.ndarray | None = None        # with an [environment]: (M, A, S) uint8, see simkit.environment
+    nlos_delay: np.ndarray | None = None       # with an [environment]: (M, A, S) m, extra path of the reflection
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,8 @@ import numpy as np
 from .. import frames, gpstime, rng
 from ..constellation import Sky, antenna_view
 from ..earth import C_LIGHT
-from . import atmosphere, noise, signals as sigmod
+from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
+from . import atmosphere, noise, signals as sigmod, tworay
 from .clock import ClockProcess
 from .config import GnssConfig, check_sats
 from .draws import KeyedNormals
@@ -43,8 +44,8 @@ class GnssSimulator:
     satellites, the scenario start in GPS time, the seed and the duration (s)."""
 
     def __init__(self, cfg: GnssConfig, sky: Sky, start_week: int, start_sow: float, seed: int,
-                 duration_s: float):
-        self.cfg, self.sky = cfg, sky
+                 duration_s: float, environment: Environment | None = None):
+        self.cfg, self.sky, self.env = cfg, sky, environment
         self.start_week, self.start_sow = int(start_week), float(start_sow)
         self.duration_s = float(duration_s)
         self.dt = 1.0 / cfg.rate_hz
@@ -72,6 +73,7 @@ class GnssSimulator:
                               (self.n_ant, len(self.sat_ids), len(self.signals), 2))
         self.tracking = Tracking(cfg, seed, self.sat_ids, self.n_ant)
         self.vis = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)
+        self.nlos = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)   # tracking a reflection only
         self.sat_index = {sid: k for k, sid in enumerate(self.sat_ids)}
 
     def _group_delays(self) -> np.ndarray:
@@ -114,8 +116,8 @@ class GnssSimulator:
         truth there: IMU-centre position (M, 3) m and velocity (M, 3) m/s in ECEF, attitude body->ENU (M, 4)
         scalar-last, body rate w.r.t. inertial space (M, 3) rad/s.
 
-        Per-antenna work is done only for the satellites near or above the elevation mask at some epoch of the
-        block (the candidate columns); the arrays are NaN elsewhere.
+        Per-antenna work is done only for the satellites near or above the elevation mask (with an environment:
+        above the horizon) at some epoch of the block (the candidate columns); the arrays are NaN elsewhere.
         """
         t = np.asarray(t, dtype=float)
         pos = np.asarray(pos_ecef, dtype=float).reshape(t.size, 3)
@@ -123,25 +125,32 @@ class GnssSimulator:
         ant_pos, ant_vel, c_be = frames.lever_arm_ecef(pos, np.asarray(vel_ecef, dtype=float).reshape(t.size, 3),
                                                        quat_nb, omega_ib_b, self.lever)
         ref = self.sky.view(pos, week, sow)
+        low = self.cfg.elevation_mask_rad if self.env is None else min(self.cfg.elevation_mask_rad, 0.0)
         with np.errstate(invalid="ignore"):
-            cand = np.flatnonzero((ref["elevation"] >= self.cfg.elevation_mask_rad - _MASK_MARGIN_RAD).any(axis=0))
+            cand = np.flatnonzero((ref["elevation"] >= low - _MASK_MARGIN_RAD).any(axis=0))
         view = antenna_view({k: v[:, cand] for k, v in ref.items()}, ant_pos, ant_vel)
-        vis_c, off = self._visibility(t, view, c_be, cand)
+        los = None
+        if self.env is not None:
+            los = self.env.classify(ant_pos, view.lla, view.vel_enu, view.los, view.azimuth, view.elevation,
+                                    view.azimuth_rate, view.elevation_rate, c_be)
+        vis_c, off = self._visibility(t, view, c_be, cand, los)
         k0 = int(round(t[0] * self.cfg.rate_hz))
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
-        parts = _Parts(self, t, sow, cand, view, vis_c, off, draws)
+        parts = _Parts(self, t, sow, cand, view, vis_c, off, draws, los)
         return GnssEpochs(t=t, sat_pos_ecef=ref["sat_pos_emission"], sat_clock=ref["sat_clock"],
                           truth=parts.truth(ant_pos, ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
 
     # ------------------------------------------------------------------ steps
-    def _visibility(self, t, view, c_be, cand):
+    def _visibility(self, t, view, c_be, cand, los: LineOfSight | None = None):
         """Visible (M, A, C): above the elevation mask and the antenna's body-frame horizon, outside scheduled
-        outages; and the off-boresight angle (M, A, C) rad."""
+        outages, not blocked by the environment; and the off-boresight angle (M, A, C) rad."""
         bore_e = np.einsum("mij,aj->mai", c_be, self.boresight)            # (M, A, 3)
         off = np.arccos(np.clip(np.einsum("maci,mai->mac", view.los, bore_e), -1.0, 1.0))
         horizon = np.array([x.horizon_mask_rad for x in self.cfg.antennas])
         vis = (np.isfinite(view.range) & (view.elevation >= self.cfg.elevation_mask_rad)
                & (np.pi / 2.0 - off >= horizon[None, :, None]))
+        if los is not None:
+            vis &= los.state <= NLOS
         for o in self.cfg.outages:
             rows = (t >= o.start_s) & (t < o.end_s)
             ants = np.zeros(self.n_ant, dtype=bool)
@@ -175,21 +184,28 @@ class GnssSimulator:
 class _Parts:
     """The error terms and observables of one block, computed step by step on the candidate columns."""
 
-    def __init__(self, sim: GnssSimulator, t, sow, cand, view, vis_c, off, draws):
-        self.sim, self.cand, self.view, self.m = sim, cand, view, t.size
+    def __init__(self, sim: GnssSimulator, t, sow, cand, view, vis_c, off, draws, los=None):
+        self.sim, self.cand, self.view, self.m, self.los = sim, cand, view, t.size, los
         self.shape = (t.size, sim.n_ant, len(sim.sat_ids))
         err = sim.cfg.errors
         vis = self.full(vis_c, False)
         tracked = vis[..., None] & sim.carries[None, None, :, :]            # (M, A, S, G)
-        restart = (vis & ~np.concatenate([sim.vis[None], vis[:-1]], axis=0))[..., cand]
+        prev_vis = np.concatenate([sim.vis[None], vis[:-1]], axis=0)
+        restart = (vis & ~prev_vis)[..., cand]
         sim.vis = vis[-1].copy()
+        reacquire = None
+        if los is not None:  # a loop switching between the direct signal and a reflection loses lock
+            nlos = self.full(los.state == NLOS, False)
+            switch = vis & prev_vis & (nlos != np.concatenate([sim.nlos[None], nlos[:-1]], axis=0))
+            sim.nlos = nlos[-1].copy()
+            reacquire = switch[..., None] & sim.carries[None, None, :, :]
         self._clocks(err)
         self.el = np.where(np.isfinite(view.elevation), np.maximum(view.elevation, 1e-3), np.pi / 2)
         self.az = np.where(np.isfinite(view.azimuth), view.azimuth, 0.0)
         self._troposphere(err)
         self._ionosphere(err, sow)
         self.mp = sim.mp.advance(draws[..., 3:5], restart, index=(slice(None), cand)) if err["multipath"] else None
-        amb, lli = sim.tracking.advance(t, tracked)
+        amb, lli = sim.tracking.advance(t, tracked, reacquire)
         self.obs, self.signal_truth = {}, {}
         for j, g in enumerate(sim.signals):
             self._signal(j, g, off, draws, tracked, amb, lli)
@@ -254,6 +270,10 @@ class _Parts:
                 self.mp[:, :, cj, j, 1]
         else:
             mp_c = mp_p = np.zeros(cn0.shape)
+        mp_rate = None
+        if self.los is not None:
+            cn0, mp_c, mp_p, mp_rate = self._environment(cj, g, cn0, mp_c, mp_p)
+            sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g))
         n_c, n_p, n_d = (draws[:, :, cj, j, i] * s for i, s in enumerate((sig_c, sig_p, sig_d)))
         gd = C_LIGHT * sim.group_delay_s[cols, j] * err["group_delay"]
         base = self.view.range[..., cj] + self.clk[..., cj] + self.trop[..., cj]
@@ -268,12 +288,39 @@ class _Parts:
         self.obs[g.name] = SignalObs(
             code=put(base + gd + iono + mp_c + n_c, True),
             carrier=put((base - iono + mp_p + n_p) / g.wavelength_m + amb[..., cols, j], True),
-            doppler=put(-(rate - iono_rate) / g.wavelength_m + n_d, True), cn0=put(cn0, True),
+            doppler=put(-(rate - iono_rate + (0.0 if mp_rate is None else mp_rate)) / g.wavelength_m + n_d, True),
+            cn0=put(cn0, True),
             ambiguity=amb[..., j], lli=lli[..., j])
         self.signal_truth[g.name] = SignalTruth(
             ionosphere=put(iono), ionosphere_rate=put(iono_rate), multipath_code=put(mp_c),
             multipath_carrier=put(mp_p), noise_code=put(n_c), noise_carrier=put(n_p), noise_doppler=put(n_d),
-            sigma_code=put(sig_c), sigma_carrier=put(sig_p), sigma_doppler=put(sig_d))
+            sigma_code=put(sig_c), sigma_carrier=put(sig_p), sigma_doppler=put(sig_d),
+            multipath_rate=None if mp_rate is None else put(mp_rate))
+
+    def _environment(self, cj, g, cn0, mp_c, mp_p):
+        """C/N0 and multipath of signal ``g`` on columns ``cj`` under the environment: a direct signal plus a
+        reflection gets the two-ray errors (:mod:`simkit.gnss.tworay`) instead of the statistical multipath, a
+        reflection alone (NLOS) carries its extra path on code and carrier and loses the reflection loss;
+        returns C/N0, code and carrier multipath (m) and the carrier multipath rate (m/s)."""
+        cfg = self.sim.env.cfg
+        st, ex, ex_rate = self.los.state[..., cj], self.los.extra[..., cj], self.los.extra_rate[..., cj]
+        alpha = 10.0 ** (-cfg.reflection_loss_db / 20.0)
+        two, nl = st == DIRECT_REFLECTED, st == NLOS
+        lam = g.wavelength_m
+        theta = 2.0 * np.pi * ex[two] / lam + np.pi
+        theta_rate = 2.0 * np.pi * ex_rate[two] / lam
+        code_two = tworay.dll_error_chips(alpha, ex[two] / g.chip_length_m, theta,
+                                          self.sim.cfg.noise.correlator_spacing_chips) * g.chip_length_m
+        cn0, mp_c, mp_p = cn0.copy(), mp_c.copy(), mp_p.copy()
+        rate = np.zeros(cn0.shape)
+        cn0[two] += tworay.amplitude_gain_db(alpha, theta)
+        cn0[nl] -= cfg.reflection_loss_db
+        mp_c[two] = code_two
+        mp_p[two] = tworay.carrier_phase_error(alpha, theta) * lam / (2.0 * np.pi)
+        rate[two] = tworay.carrier_phase_error_rate(alpha, theta, theta_rate) * lam / (2.0 * np.pi)
+        mp_c[nl] = mp_p[nl] = ex[nl]
+        rate[nl] = ex_rate[nl]
+        return cn0, mp_c, mp_p, rate
 
     def truth(self, ant_pos, ant_vel) -> GnssTruth:
         v = self.view
@@ -282,4 +329,6 @@ class _Parts:
                          azimuth=self.full(v.azimuth), receiver_clock=self.rx_clk,
                          receiver_clock_drift=self.rx_clk_rate, satellite_clock=self.full(self.sat_clk),
                          satellite_clock_drift=self.full(self.sat_clk_rate), troposphere=self.full(self.trop),
-                         troposphere_rate=self.full(self.trop_rate))
+                         troposphere_rate=self.full(self.trop_rate),
+                         los_state=None if self.los is None else self.full(self.los.state, 255),
+                         nlos_delay=None if self.los is None else self.full(self.los.extra))

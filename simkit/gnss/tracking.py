@@ -39,10 +39,11 @@ class Tracking:
                     self.next_slip[a, s] = self.streams[a][s].exponential(1.0 / self.slip_rate, shape[2])
         self.t_last = -np.inf
 
-    def advance(self, t: np.ndarray, tracked: np.ndarray):
+    def advance(self, t: np.ndarray, tracked: np.ndarray, reacquire: np.ndarray | None = None):
         """Ambiguities (M, A, S, G) int64 cycles and LLI flags (M, A, S, G) uint8 at epochs ``t`` (M,) s, given
-        which channels are tracked (M, A, S, G)."""
-        events = self._acquisitions(tracked)
+        which channels are tracked (M, A, S, G); ``reacquire`` (M, A, S, G), optional: channels that lose lock
+        and reacquire at that epoch although tracked before (the loop switched to another ray)."""
+        events = self._acquisitions(tracked, reacquire)
         if self.cfg.errors["cycle_slips"]:
             self._poisson_starts(t, events)
             self._scheduled(t, events)
@@ -55,10 +56,11 @@ class Tracking:
         self.t_last = float(t[-1])
         return amb, lli
 
-    def _acquisitions(self, tracked) -> dict:
+    def _acquisitions(self, tracked, reacquire=None) -> dict:
         prev = np.concatenate([self.tracked[None], tracked[:-1]], axis=0)
+        new = tracked & ~prev if reacquire is None else tracked & (~prev | reacquire)
         events: dict[tuple, list] = {}
-        for k, a, s, g in zip(*np.nonzero(tracked & ~prev)):
+        for k, a, s, g in zip(*np.nonzero(new)):
             events.setdefault((a, s), []).append((k, g, _ACQUIRE, None))
         return events
 

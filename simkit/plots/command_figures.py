@@ -40,9 +40,15 @@ def allan_figure(path, taus, dev, fits, sensor: str, unit: str) -> None:
     _write(plt, fig, path, Path(path).suffix.lstrip(".").lower())
 
 
-def sky_figure(path, kind: str, const, geo, vis, title: str) -> None:
+STATE_MARKS = {1: ("^", "tab:orange", "direct + reflection"), 2: ("o", "tab:purple", "NLOS (reflection only)"),
+               3: ("x", "0.5", "blocked")}
+
+
+def sky_figure(path, kind: str, const, geo, vis, title: str, states=None) -> None:
     """Polar sky plot of the visible tracks: azimuth clockwise from north, radius elevation (deg); ``geo`` the
-    constellation geometry (azimuth, elevation in rad, (T, S)), ``vis`` (T, S) the visible mask."""
+    constellation geometry (azimuth, elevation in rad, (T, S)), ``vis`` (T, S) the visible mask; ``states``
+    (T, S) line-of-sight states (``simkit.environment``), when given, mark the reflected, NLOS and blocked
+    points."""
     plt = require_matplotlib("--plot")
     fig = plt.figure(figsize=(8, 7), layout="constrained")
     ax = fig.add_subplot(projection="polar")
@@ -54,11 +60,17 @@ def sky_figure(path, kind: str, const, geo, vis, title: str) -> None:
         if not ok.any():
             continue
         az, el = geo.azimuth[ok, s], np.degrees(geo.elevation[ok, s])
-        ax.plot(az, el, ".", ms=3, color=SYSTEM_COLOURS.get(sid[0], ("k",))[0])
+        st = np.zeros(az.size, dtype=int) if states is None else states[ok, s]
+        ax.plot(az[st == 0], el[st == 0], ".", ms=3, color=SYSTEM_COLOURS.get(sid[0], ("k",))[0])
+        for code, (marker, colour, _) in STATE_MARKS.items():
+            ax.plot(az[st == code], el[st == code], marker, ms=3, color=colour, mfc="none")
         ax.annotate(f"{sid} {const.orbit_type[s][0]}", (az[-1], el[-1]), fontsize=7)
     for system, (colour, name) in SYSTEM_COLOURS.items():   # one legend entry per system drawn
         if any(sid[0] == system and vis[:, s].any() for s, sid in enumerate(const.sat_ids)):
             ax.plot([], [], ".", ms=6, color=colour, label=name)
+    for code, (marker, colour, name) in STATE_MARKS.items():
+        if states is not None and (vis & (states == code)).any():
+            ax.plot([], [], marker, ms=6, color=colour, mfc="none", label=name)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="upper left", bbox_to_anchor=(0.98, 1.0), fontsize=8,
                   title="labels: PRN, orbit\n(M MEO, I IGSO, G GEO)", title_fontsize=7)

@@ -50,11 +50,18 @@ def _trajectory(plt, ds):
     return fig
 
 
+STATE_STYLE = {1: ("^", "tab:orange", "direct + reflection"), 2: ("o", "tab:purple", "reflection only (NLOS)"),
+               3: ("x", "0.5", "blocked")}
+
+
 def _sky(plt, ds):
     if not has(ds, "gnss_truth", "elevation"):
         return None
-    g = read_gnss(ds, signals=(), antennas=0, epochs=_every(ds), truth=("elevation", "azimuth"), satellites=False)
+    with_los = has(ds, "gnss_truth", "los_state")
+    g = read_gnss(ds, signals=(), antennas=0, epochs=_every(ds),
+                  truth=("elevation", "azimuth") + (("los_state",) if with_los else ()), satellites=False)
     el, az = g.truth["elevation"], g.truth["azimuth"]
+    state = g.truth["los_state"] if with_los else np.zeros(el.shape, dtype=np.uint8)
     ids = [str(s) for s in g.sat_id]
     fig = plt.figure(figsize=(6.5, 6.5))
     ax = fig.add_subplot(projection="polar")
@@ -65,15 +72,43 @@ def _sky(plt, ds):
         up = el[:, s] > 0
         system = ids[s][0]
         color = {"G": "tab:blue", "C": "tab:red"}.get(system, "tab:gray")
-        ax.plot(az[up, s], 90 - np.degrees(el[up, s]), ".", ms=2, color=color,
+        direct = up & (state[:, s] == 0)
+        ax.plot(az[direct, s], 90 - np.degrees(el[direct, s]), ".", ms=2, color=color,
                 label={"G": "GPS", "C": "BeiDou"}.get(system, system) if system not in seen else None)
         seen.add(system)
+        for code, (marker, colour, name) in STATE_STYLE.items():
+            sel = up & (state[:, s] == code)
+            ax.plot(az[sel, s], 90 - np.degrees(el[sel, s]), marker, ms=3, color=colour, mfc="none",
+                    label=name if name not in seen and sel.any() else None)
+            seen.add(name) if sel.any() else None
         k = np.flatnonzero(up)[-1]
         ax.annotate(ids[s], (az[k, s], 90 - np.degrees(el[k, s])), fontsize=7)
     ax.set_ylim(0, 90)
     ax.set_yticks([0, 30, 60, 90], labels=["90 deg", "60 deg", "30 deg", "0 deg"])
-    ax.set_title("sky plot, antenna 0 (azimuth clockwise from north, elevation in deg)")
+    ax.set_title("sky plot, antenna 0 (azimuth clockwise from north, elevation in deg)"
+                 + ("\ndots: direct line of sight; other marks: the environment's states" if with_los else ""))
     ax.legend(loc="lower left", fontsize=8)
+    return fig
+
+
+def _line_of_sight(plt, ds):
+    """Per-epoch counts of each line-of-sight state above the horizon, one panel per antenna."""
+    if not has(ds, "gnss_truth", "los_state"):
+        return None
+    g = read_gnss(ds, signals=(), epochs=_every(ds), truth=("los_state",), satellites=False)
+    state = g.truth["los_state"]                                             # (M, A, S)
+    n_ant = state.shape[1]
+    fig, axes = plt.subplots(n_ant, 1, figsize=(8, 2.6 * n_ant + 0.6), sharex=True, squeeze=False,
+                             layout="constrained")
+    for a, ax in enumerate(axes[:, 0]):
+        ax.step(g.t, (state[:, a] == 0).sum(axis=1), where="post", color="tab:green", label="direct")
+        for code, (_, colour, name) in STATE_STYLE.items():
+            ax.step(g.t, (state[:, a] == code).sum(axis=1), where="post", color=colour, label=name)
+        ax.set_ylabel("satellites [count]")
+        ax.set_title(f"line-of-sight states above the horizon, antenna {a}")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8, loc="upper right")
+    axes[-1, 0].set_xlabel("time since scenario start [s]")
     return fig
 
 
@@ -151,7 +186,7 @@ def _observations(plt, ds):
 
 
 FIGURES = {"trajectory": _trajectory, "sky": _sky, "satellites_dop": _dops, "imu_allan": _allan,
-           "observation_errors": _observations}
+           "observation_errors": _observations, "line_of_sight": _line_of_sight}
 
 
 def file_figures(path, out, progress=None, on_skip=skip_line) -> list[Path]:

@@ -82,6 +82,25 @@ def _where(meta: dict) -> str:
     return f"; position and velocity in ENU, at the point {meta.get('point', 'imu')!r}"
 
 
+def _state_lines(sc: Score) -> list[str]:
+    """RMS per line-of-sight class of the epochs (files with an [environment])."""
+    if not sc.by_state:
+        return []
+    names = list(sc.by_state)
+    out = ["", "## By line-of-sight state", "",
+           "Epochs classed by the worst signal tracked: nlos (a reflection only), reflected (a reflection beside "
+           "the direct signal), direct. RMS per class; satellites per antenna: direct / direct+reflected / NLOS / "
+           "blocked.", "",
+           "| quantity | unit | " + " | ".join(f"{n} RMS" for n in names) + " |", "|---|---|" + "---:|" * len(names)]
+    for q in sc.statistics:
+        out.append(f"| {q} | {UNIT_TEXT[UNIT_OF[q]]} | "
+                   + " | ".join(_fmt(sc.by_state[n]["statistics"][q]["rms"]) for n in names) + " |")
+    out.append("| epochs | | " + " | ".join(str(sc.by_state[n]["epochs"]) for n in names) + " |")
+    out.append("| satellites per antenna | | " + " | ".join(
+        " / ".join(f"{v:.1f}" for v in sc.by_state[n]["satellites_per_antenna"].values()) for n in names) + " |")
+    return out
+
+
 def to_markdown(sc: Score, label: str = "", truth: str = "") -> str:
     """A Markdown report: statistics table, convergence, NEES/NIS, checks and the verdict."""
     m = sc.meta
@@ -93,6 +112,7 @@ def to_markdown(sc: Score, label: str = "", truth: str = "") -> str:
            "| quantity | unit | " + " | ".join(STATS) + " |", "|---|---|" + "---:|" * len(STATS)]
     for q, row in sc.statistics.items():
         out.append(f"| {q} | {UNIT_TEXT[UNIT_OF[q]]} | " + " | ".join(_fmt(row[s]) for s in STATS) + " |")
+    out += _state_lines(sc)
     out += ["", "## Convergence", ""]
     out += [f"- {q}: |error| <= {c['threshold']:g} {UNIT_TEXT[UNIT_OF[q]]} "
             + (f"for good from {c['time_s']:.2f} s after the first epoch" if c["time_s"] is not None

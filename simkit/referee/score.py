@@ -8,6 +8,7 @@ import numpy as np
 from ..solution import Solution
 from . import stats
 from .compare import Errors, compare
+from .line_of_sight import by_state
 from .spec import Spec
 from .truth import Truth
 
@@ -27,6 +28,7 @@ class Score:
     checks: list = field(default_factory=list)
     meta: dict = field(default_factory=dict)
     bands: dict = field(default_factory=dict)
+    by_state: dict = field(default_factory=dict)   # errors per line-of-sight class (simkit.referee.line_of_sight)
 
     @property
     def passed(self) -> bool:
@@ -38,12 +40,14 @@ class Score:
         strip = (lambda d: None if d is None else {k: v for k, v in d.items() if k not in ("series", "dof")})
         return {"meta": self.meta, "units": {q: stats.UNIT_OF[q] for q in self.statistics},
                 "statistics": self.statistics, "convergence": self.convergence, "nees": strip(self.nees),
-                "nis": strip(self.nis), "checks": self.checks, "passed": self.passed}
+                "nis": strip(self.nis), "checks": self.checks, "passed": self.passed,
+                **({"by_line_of_sight": self.by_state} if self.by_state else {})}
 
 
-def score(truth: Truth, sol: Solution, spec: Spec | None = None, where: str = "estimate") -> Score:
+def score(truth: Truth, sol: Solution, spec: Spec | None = None, where: str = "estimate", path=None) -> Score:
     """Score ``sol`` against ``truth`` (see :mod:`simkit.referee.stats` for quantities and tests) and check it
-    against ``spec`` (no checks without one)."""
+    against ``spec`` (no checks without one); ``path``, the simkit file of the truth, adds the statistics per
+    line-of-sight class of the epochs when it has them (:mod:`simkit.referee.line_of_sight`)."""
     spec = spec if spec is not None else Spec()
     err = compare(truth, sol, where)
     series = stats.series(err)
@@ -59,7 +63,8 @@ def score(truth: Truth, sol: Solution, spec: Spec | None = None, where: str = "e
             "t_first_s": float(err.t[0]), "t_last_s": float(err.t[-1]), "point": sol.point,
             "not_estimated": missing}
     bands = stats.sigma_bands(err, sol.cov, sol.state_names) if sol.cov is not None else {}
-    return Score(err, table, conv, nees, nis, _checks(spec, table, conv, nees, nis), meta, bands)
+    per_state = by_state(path, err, series) if path is not None else {}
+    return Score(err, table, conv, nees, nis, _checks(spec, table, conv, nees, nis), meta, bands, per_state)
 
 
 def _check(name, value, limit, passed):

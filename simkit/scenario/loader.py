@@ -1,7 +1,7 @@
 """Loading a scenario: TOML (tomllib) or a dict, ``--set`` overrides, validation into one :class:`Scenario`.
 
-The top-level tables are ``[scenario]``, ``[trajectory]``, ``[imu]`` and ``[gnss]``; each stage validates its own
-table. Every error is a :class:`ScenarioError` naming the file and the dotted key path.
+The top-level tables are ``[scenario]``, ``[trajectory]``, ``[imu]``, ``[gnss]`` and ``[environment]``; each
+stage validates its own table. Every error is a :class:`ScenarioError` naming the file and the dotted key path.
 """
 from __future__ import annotations
 
@@ -14,11 +14,13 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import tomli_w
 
 from .. import gpstime
 from ..errors import ScenarioError
 from ..params import parse_value
+from ..environment import EnvironmentConfig, check_antennas, parse_config as parse_environment
 from ..gnss import GnssConfig, parse_config as parse_gnss
 from ..imu import ImuConfig, parse_config as parse_imu
 from ..section import Section, positive
@@ -64,6 +66,7 @@ class Scenario:
     trajectory: TrajectoryConfig
     imu: ImuConfig | None = None
     gnss: GnssConfig | None = None
+    environment: EnvironmentConfig | None = None
     text: str = ""
     source: str = ""
     data: dict = field(default_factory=dict)
@@ -114,11 +117,12 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
         if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
             raise ScenarioError("--seed", f"expected an integer in [0, 2^64 - 1], got {seed!r}")
         overrides.append(f"scenario.seed={seed}")
+    base_dir = None
     if isinstance(scenario, dict):
         data, text, source = copy.deepcopy(scenario), None, "<dict>"
     else:
         path = resolve(scenario)
-        source = str(scenario)
+        source, base_dir = str(scenario), path.parent
         try:
             text = path.read_text(encoding="utf-8")
             data = tomllib.loads(text)
@@ -129,7 +133,7 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
     try:
         for item in overrides:
             apply_override(data, item)
-        sc = _validate(data, None if isinstance(scenario, dict) else path.parent)
+        sc = _validate(data, base_dir)
     except ScenarioError as exc:
         raise exc.with_source(source) from None
     if text is None or overrides:
@@ -138,7 +142,7 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
     return replace(sc, text=text, source=source, data=data, overrides=tuple(overrides))
 
 
-def _validate(data: dict, base: Path | None = None) -> Scenario:
+def _validate(data: dict, base_dir: Path | None = None) -> Scenario:
     root = Section(data, "")
     meta = root.section("scenario", required=True)
     name = meta.get("name", str, check=lambda v: None if re.fullmatch(r"[\w.-]+", v) else
@@ -158,7 +162,7 @@ def _validate(data: dict, base: Path | None = None) -> Scenario:
     if traj.log is not None:   # a logged trajectory: read and fitted now, so a bad log is reported at load
         from ..logs import fit_trajectory
 
-        traj = fit_trajectory(traj, base, start, week, sow, duration)
+        traj = fit_trajectory(traj, base_dir, start, week, sow, duration)
     imu = gnss = None
     if root.has("imu"):
         imu = parse_imu(root.section("imu"))
@@ -172,6 +176,12 @@ def _validate(data: dict, base: Path | None = None) -> Scenario:
         if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
             raise ScenarioError("gnss.rate_hz", f"must divide trajectory.rate_hz ({traj.rate_hz:g}) into a whole "
                                 f"number of samples, got {gnss.rate_hz:g}")
+    env = None
+    if root.has("environment"):
+        if gnss is None:
+            raise ScenarioError("environment", "needs a [gnss] section: the environment acts on its signals")
+        env = parse_environment(root.section("environment"), (traj.lat_rad, traj.lon_rad, traj.height_m), base_dir)
+        check_antennas(env, np.array([a.lever_arm_b for a in gnss.antennas]))
     root.done()
     return Scenario(name=name, description=description, start=start, start_week=week, start_sow=sow,
-                    duration_s=duration, seed=seed, trajectory=traj, imu=imu, gnss=gnss)
+                    duration_s=duration, seed=seed, trajectory=traj, imu=imu, gnss=gnss, environment=env)
