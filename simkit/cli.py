@@ -15,7 +15,8 @@ from .commands import silence_stdout
 from .errors import InputError, SimkitError
 from .version import __version__
 
-COMMANDS = ("run", "inspect", "solve", "validate", "score", "plot", "regress", "campaign", "allan", "sky", "rinex")
+COMMANDS = ("run", "inspect", "solve", "validate", "score", "plot", "regress", "campaign", "allan", "sky", "rinex",
+            "import")
 
 
 class _Parser(argparse.ArgumentParser):
