@@ -232,9 +232,9 @@ def _sat_id(text: str, path, line: int, default: str) -> str:
     return f"{sys}{int(num):02d}"
 
 
-def _epoch_seconds(y, mo, d, h, mi, sec) -> float:
-    return (date(y, mo, d).toordinal() - gpstime.GPS_EPOCH_ORDINAL) * gpstime.SECONDS_PER_DAY + h * 3600.0 \
-        + mi * 60.0 + sec
+def _epoch_seconds(y, mo, d, h, mi, sec) -> tuple[int, float]:
+    """(days since the GPS epoch, seconds of day): two numbers, so that differences keep sub-ns resolution."""
+    return date(y, mo, d).toordinal() - gpstime.GPS_EPOCH_ORDINAL, h * 3600.0 + mi * 60.0 + sec
 
 
 class _Walker:
@@ -407,16 +407,16 @@ def read(path) -> ObsFile:
     if not walker.times:
         raise DataFileError(path, "no observation epoch after the header")
     offset = SUPPORTED_TIME_SYSTEMS[hdr.time_system]
-    times = np.array(walker.times) + offset
+    days = np.array([d for d, _ in walker.times], np.int64)
+    sod = np.array([s for _, s in walker.times]) + offset
+    times = (days - days[0]) * gpstime.SECONDS_PER_DAY + (sod - sod[0])
     if np.any(np.diff(times) <= 0):
         k = int(np.flatnonzero(np.diff(times) <= 0)[0])
         raise DataFileError(path, f"epoch {k + 2} is not later than the epoch before it: epochs must increase")
-    t0 = times[0]
-    week = int(np.floor(t0 / gpstime.SECONDS_PER_WEEK))
-    start_sow = t0 - week * gpstime.SECONDS_PER_WEEK
+    week, start_sow = gpstime.normalize(int(days[0]) // 7, (int(days[0]) % 7) * gpstime.SECONDS_PER_DAY + sod[0])
     systems = _systems(walker, hdr, lines, path)
     notes = [f"{kind}: {count} (first at line {walker.first_note[kind]})" for kind, count in walker.notes.items()]
-    return ObsFile(str(path), hdr, (week, float(start_sow)), times - t0, systems, np.array(walker.clocks), notes)
+    return ObsFile(str(path), hdr, (int(week), float(start_sow)), times, systems, np.array(walker.clocks), notes)
 
 
 def _systems(walker: _Walker, hdr: ObsHeader, lines, path) -> dict:
