@@ -182,3 +182,11 @@ def broadcast_ionosphere(ds):
     systems = [str(x) for x in ds["gnss/iono_systems"][:]]
     alpha, beta = ds["gnss/iono_alpha"][:], ds["gnss/iono_beta"][:]
     return {k: (alpha[i], beta[i]) for i, k in enumerate(systems)}
+
+
+def read_reference(ds):
+    """(pos_ecef (3,) m, source text, kind) of a real file's /reference (``simkit import``), None without one."""
+    if "reference/pos_ecef" not in ds:
+        return None
+    attrs = ds.group_attrs("reference")
+    return ds["reference/pos_ecef"][:], str(attrs.get("source", "unknown")), str(attrs.get("kind", "static"))

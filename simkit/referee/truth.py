@@ -15,7 +15,7 @@ import numpy as np
 
 
 from .. import frames
-from ..io import TRUTH_CORE, Truth, has, open_dataset
+from ..io import TRUTH_CORE, Truth, has, open_dataset, read_reference
 from ..io import read_truth as read_file_truth
 from ..solution import parse_point
 from . import quat
@@ -27,10 +27,34 @@ def read_truth(path, t_min: float | None = None, t_max: float | None = None) -> 
     present, the antenna lever arms) of the simkit file ``path``; with ``t_min`` / ``t_max`` (s) only the
     samples that bracket that span are read (bounded memory for long files)."""
     with open_dataset(path) as ds:
+        if not has(ds, "truth", "t") and read_reference(ds) is not None:
+            return static_reference(ds)
         missing = [k for k in ("t",) + TRUTH_CORE if not has(ds, "truth", k)]
         if missing:
             raise RefereeInputError(path, f"no /truth/{missing[0]} dataset: scoring needs the truth trajectory")
         return read_file_truth(ds, span=(t_min, t_max))
+
+
+def truth_source(path) -> str:
+    """Which truth :func:`read_truth` uses for the file ``path``: "/truth", or "/reference (<its source>)" for a
+    real file (``simkit import``), which has no /truth."""
+    with open_dataset(path) as ds:
+        if has(ds, "truth", "t"):
+            return "/truth"
+        ref = read_reference(ds)
+        return "none" if ref is None else f"/reference ({ref[2]}: {ref[1]})"
+
+
+def static_reference(ds) -> Truth:
+    """The static /reference of a real file as a truth over its GNSS epochs: the position, zero velocity, and an
+    identity attitude that only carries the zero lever arm of its one antenna (an attitude is never scored
+    against it: :func:`simkit.api.score` refuses)."""
+    pos, _, _ = read_reference(ds)
+    t = ds["gnss/t"][:]
+    span = np.array([t[0], t[-1] if t[-1] > t[0] else t[0] + 1.0])
+    lever = ds["gnss/antennas/lever_arm_b"][:] if "gnss/antennas/lever_arm_b" in ds else np.zeros((1, 3))
+    return Truth(span, np.tile(pos, (2, 1)), np.zeros((2, 3)), np.tile([0.0, 0.0, 0.0, 1.0], (2, 1)),
+                 np.zeros((2, 3)), lever)
 
 
 def overlap(truth: Truth, t: np.ndarray, where: str = "estimate") -> np.ndarray:
