@@ -155,6 +155,9 @@ def compare(real: dict, twin: dict, reference, mask_deg: float) -> dict:
            "tracked_real_not_twin": int((r_on & ~t_on & above).sum()),
            "tracked_twin_not_real": int((t_on & ~r_on & above).sum()),
            "tracked_below_mask_real": int((r_on & ~above).sum()),
+           "disagreement_max_elevation_deg": float(np.degrees(el[above & (r_on != t_on)]).max())
+           if (above & (r_on != t_on)).any() else None,
+           "tracked_series": {"t": twin["t"].tolist(), "real": r_on.sum(1).tolist(), "twin": t_on.sum(1).tolist()},
            "real": {k: v for k, v in rs.items() if k != "_series"},
            "twin": {k: v for k, v in ts.items() if k != "_series"},
            "satellites_without_orbit": real.get("not_in_twin", [])}
@@ -348,3 +351,63 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
                                       progress)
     (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
     return result
+
+
+def _fmt(v, digits=2):
+    return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else f"{v:.{digits}f}"
+
+
+def report_markdown(fid: dict, figures=()) -> str:
+    """report.md of a twin: the comparison tables of :func:`compare` for the default (and fitted) twin."""
+    runs = [k for k in ("default", "fitted") if k in fid]
+    base = fid[runs[0]]
+    edges = base["elevation_bins_deg"]
+    bins = [f"{a:g}-{b:g}" for a, b in zip(edges[:-1], edges[1:])]
+    out = [f"# Twin of {fid['obs']}", "",
+           f"Navigation: {', '.join(fid['nav'])}. Reference: {fid['reference']}. {fid['epochs']} epochs over "
+           f"{fid['span_s']:.0f} s; signals {', '.join(fid['signals'])}; elevation mask inferred from the data: "
+           f"{base['mask_deg']:g} deg. Twin: simkit defaults" + (", and the calibrated twin (--fit, "
+                                                                  "fitted.toml)." if "fitted" in fid else "."), ""]
+    out += ["## Tracking", "", "| twin | visibility agreement | satellite-epochs above the mask | tracked real only "
+            "| tracked twin only | highest elevation of a disagreement (deg) | tracked per epoch real / twin |",
+            "|---|---:|---:|---:|---:|---:|---|"]
+    for k in runs:
+        c = fid[k]
+        out.append(f"| {k} | {_fmt(100 * c['visibility_agreement'], 1)} % | {c['satellite_epochs_above_mask']} | "
+                   f"{c['tracked_real_not_twin']} | {c['tracked_twin_not_real']} | "
+                   f"{_fmt(c['disagreement_max_elevation_deg'], 1)} | {_fmt(c['real']['tracked_per_epoch']['mean'], 1)}"
+                   f" / {_fmt(c['twin']['tracked_per_epoch']['mean'], 1)} |")
+    for quantity, title, digits in (("cn0_dbhz", "C/N0 (dB-Hz), mean per elevation bin (deg)", 1),
+                                    ("code_noise_m", "Code noise and multipath sigma (m) per elevation bin (deg), "
+                                     "from the code-minus-carrier", 3)):
+        out += ["", f"## {title}", "", "| signal | file | " + " | ".join(bins) + " |",
+                "|---|---|" + "---:|" * len(bins)]
+        for s in fid["signals"]:
+            out.append(f"| {s} | real | " + " | ".join(_fmt(v, digits) for v in base["real"][quantity][s]) + " |")
+            for k in runs:
+                out.append(f"| {s} | twin ({k}) | " + " | ".join(_fmt(v, digits) for v in fid[k]["twin"][quantity][s])
+                           + " |")
+    out += ["", "C/N0 RMS difference over the bins (dB-Hz): " + "; ".join(
+        f"{k}: " + ", ".join(f"{s} {_fmt(v)}" for s, v in fid[k]["cn0_rms_difference_dbhz"].items()) for k in runs)]
+    out += ["", "Code-noise ratio twin / real per bin: " + "; ".join(
+        f"{k}: {_within(fid[k]['code_noise_ratio'])}" for k in runs)]
+    out += ["", "## Carrier, Doppler, slips", "", "| quantity | real | " + " | ".join(f"twin ({k})" for k in runs)
+            + " |", "|---|---:|" + "---:|" * len(runs)]
+    for key, label, d in (("carrier_noise_m", "carrier noise (m, geometry-free 3rd difference / sqrt 20)", 4),
+                          ("doppler_noise_hz", "Doppler noise (Hz)", 3), ("slips_per_hour", "LLI slips per hour", 2)):
+        for s, v in base["real"][key].items():
+            out.append(f"| {label} {s} | {_fmt(v, d)} | " + " | ".join(_fmt(fid[k]["twin"][key].get(s), d)
+                                                                       for k in runs) + " |")
+    if "fitted_parameters" in fid:
+        out += ["", "## Fitted [gnss] parameters", "", "```toml", toml_fragment(fid["fitted_parameters"]).rstrip(),
+                "```"] + [f"- {n}" for n in fid.get("fit_notes", [])]
+    out += [""] + [f"![{Path(p).stem}]({Path(p).name})" for p in figures]
+    return "\n".join(out) + "\n"
+
+
+def _within(ratios: dict, tol: float = 0.2) -> str:
+    vals = [x for v in ratios.values() for x in v if x is not None]
+    if not vals:
+        return "no bin"
+    inside = sum(abs(x - 1.0) <= tol for x in vals)
+    return f"{inside} of {len(vals)} bins within {100 * tol:g} % (median ratio {np.median(vals):.2f})"
