@@ -216,3 +216,10 @@ def test_hatanaka_missing_is_one_line(monkeypatch, tmp_path):
     monkeypatch.setattr(builtins, "__import__", no_hatanaka)
     with pytest.raises(InputError, match="install the 'hatanaka' package"):
         rinex_obs.read(DATA / "KMS300DNK_R_20221591000_01H_30S_MO.crx")
+
+
+def test_navigation_of_another_day_is_one_line(tmp_path):
+    kms3_nav = Path(__file__).parents[1] / "simkit" / "data" / "KMS300DNK_R_20221591000_01H_MN.rnx.gz"
+    with pytest.raises(DataFileError, match=r"no broadcast record is valid during the observations \(2016-06-06 "
+                                            r"10:59:43 to .*covers .*2022-06-08"):
+        importer.import_rinex(_write(tmp_path), [kms3_nav])

@@ -219,6 +219,14 @@ def _satellites(obs, nav_paths, sats, signals, first_code, reference, report):
         p, c = _state_of(const, t_w2, t_s2, sel)
         pos[:, idx], clk[:, idx] = p, c
         have[idx] = True
+    if not np.isfinite(pos).any():
+        from ..constellation.model import describe_span
+
+        first, last = (gpstime.gps_to_utc(*gpstime.normalize(week, x)) for x in (rx_sow[0], rx_sow[-1]))
+        spans = "; ".join(f"{Path(c.source).name}: {describe_span(c.validity_span())}" for c in sky.constellations)
+        when = f"{first:%Y-%m-%d %H:%M:%S} to {last:%Y-%m-%d %H:%M:%S} UTC"
+        raise DataFileError(nav_paths[0], f"no broadcast record is valid during the observations ({when}); the "
+                            f"navigation data covers {spans}")
     gds = _group_delays(sky, sats, signals, week, rx_sow[m // 2])
     gd = gds * C_LIGHT
     orbit_ok = np.isfinite(pos[..., 0]) | np.isnan(first_code)
