@@ -198,6 +198,12 @@ def _satellites(obs, nav_paths, sats, signals, first_code, reference, report):
         report["navigation"] = "none: satellite orbits and clocks are NaN (give --nav)"
         return pos, clk, gd, {}
     sky = load_sky(nav_paths)
+    used_sys = sorted({s[0] for s in sats}, key=SYSTEM_ORDER.find)
+    nav_sys = sorted({s[0] for c in sky.constellations for s in c.sat_ids}, key=SYSTEM_ORDER.find)
+    missing = [s for s in used_sys if s not in nav_sys]
+    if not any(s in nav_sys for s in used_sys):
+        raise DataFileError(nav_paths[0], f"no broadcast ephemeris for the observed systems "
+                            f"{', '.join(used_sys)} (the navigation data has {', '.join(nav_sys) or 'none'})")
     week, sow0 = obs.start
     rx_sow = sow0 + obs.t
     tau = first_code / C_LIGHT
@@ -230,12 +236,6 @@ def _satellites(obs, nav_paths, sats, signals, first_code, reference, report):
     gds = _group_delays(sky, sats, signals, week, rx_sow[m // 2])
     gd = gds * C_LIGHT
     orbit_ok = np.isfinite(pos[..., 0]) | np.isnan(first_code)
-    used_sys = sorted({s[0] for s in sats}, key=SYSTEM_ORDER.find)
-    nav_sys = sorted({s[0] for c in sky.constellations for s in c.sat_ids}, key=SYSTEM_ORDER.find)
-    missing = [s for s in used_sys if s not in nav_sys]
-    if not any(s in nav_sys for s in used_sys):
-        raise DataFileError(nav_paths[0], f"no broadcast ephemeris for the observed systems "
-                            f"{', '.join(used_sys)} (the navigation data has {', '.join(nav_sys) or 'none'})")
     report["navigation"] = ", ".join(Path(p).name for p in nav_paths)
     if missing:
         report["notes"].append(f"navigation data without system(s) {', '.join(missing)}: their orbits are NaN")
