@@ -117,9 +117,11 @@ def _align(real: dict, twin: dict):
     """Twin column of each real satellite, real row of each twin epoch (-1 where absent)."""
     col = {s: i for i, s in enumerate(twin["sat_id"])}
     real_cols = np.array([col.get(s, -1) for s in real["sat_id"]])
-    rows = np.searchsorted(real["t"], twin["t"] - 1e-3)
-    rows = np.where((rows < real["t"].size) & (np.abs(real["t"][np.minimum(rows, real["t"].size - 1)]
-                                                         - twin["t"]) < 1e-3), rows, -1)
+    dt = float(np.median(np.diff(twin["t"]))) if twin["t"].size > 1 else 1.0
+    tol = 0.25 * dt   # receivers that tag epochs off the grid (42.3999998 s) still pair with the grid epoch
+    rows = np.clip(np.searchsorted(real["t"], twin["t"]), 1, max(real["t"].size - 1, 1))
+    rows = np.where(np.abs(real["t"][rows - 1] - twin["t"]) < np.abs(real["t"][rows] - twin["t"]), rows - 1, rows)
+    rows = np.where(np.abs(real["t"][rows] - twin["t"]) < tol, rows, -1)
     return real_cols, rows
 
 
