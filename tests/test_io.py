@@ -176,6 +176,7 @@ LAYERS = [
     {"attitude"},
     {"estimators"},
     {"referee"},
+    {"realdata"},
     {"plots"},
     {"campaign"},
     {"api"},

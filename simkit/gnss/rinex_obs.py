@@ -151,36 +151,33 @@ def read_header(lines, path):
     version = _num(first[:9], path, 1, "RINEX version")
     if not (2.10 <= version < 2.2 or 3.0 <= version < 3.1 or 4.0 <= version < 4.1):
         raise DataFileError(path, f"RINEX version {version:g} is not supported (2.10, 2.11, 3.0x or 4.00)", 1)
-    file_sys = first[40:41].strip() or "G"
-    info = {"marker": "", "receiver": "", "antenna": "", "pos": None, "delta": np.zeros(3), "interval": None,
-            "tsys": "", "applied": False}
-    types: dict[str, list[str]] = {}
-    v2_types: list[str] = []
-    n_v2 = None
-    pending = None  # (system, expected count) of a RINEX 3 obs-types record continued on the next line
+    state = _HeaderState(path, version, first[40:41].strip() or "G")
     for i, line in enumerate(lines[1:], start=2):
-        label = line[60:80].strip()
-        if label == "END OF HEADER":
-            if version < 3:
-                if n_v2 is None:
-                    raise DataFileError(path, "missing '# / TYPES OF OBSERV' header record", i)
-                if len(v2_types) != n_v2:
-                    raise DataFileError(path, f"'# / TYPES OF OBSERV' announces {n_v2} types, lists "
-                                        f"{len(v2_types)}", i)
-                systems = {"G", "R", "E", "S", "C", "J", "I"} if file_sys == "M" else {file_sys}
-                types = {s: [_v2_code(s, c, version) for c in v2_types] for s in sorted(systems)}
-            elif not types:
-                raise DataFileError(path, "missing 'SYS / # / OBS TYPES' header record", i)
-            if pending and len(types[pending[0]]) != pending[1]:
-                raise DataFileError(path, f"'SYS / # / OBS TYPES' for {pending[0]} announces {pending[1]} types, "
-                                    f"lists {len(types[pending[0]])}", i)
-            tsys = info["tsys"] or {"C": "BDT", "E": "GAL"}.get(file_sys, "GPS")
-            if tsys not in SUPPORTED_TIME_SYSTEMS:
-                raise DataFileError(path, f"time system {tsys!r} of 'TIME OF FIRST OBS' is not supported "
-                                    f"(expected {', '.join(SUPPORTED_TIME_SYSTEMS)})")
-            hdr = ObsHeader(version, file_sys, info["marker"], info["receiver"], info["antenna"], info["pos"],
-                            info["delta"], types, tsys, info["interval"], info["applied"])
-            return hdr, i
+        if line[60:80].strip() == "END OF HEADER":
+            return state.finish(i), i
+        state.read(line, i)
+    raise DataFileError(path, "no 'END OF HEADER' line: truncated header", len(lines))
+
+
+class _HeaderState:
+    """The header records read so far."""
+
+    def __init__(self, path, version, file_sys):
+        self.path, self.version, self.file_sys = path, version, file_sys
+        self.info = {"marker": "", "receiver": "", "antenna": "", "pos": None, "delta": np.zeros(3),
+                     "interval": None, "tsys": "", "applied": False}
+        self.types: dict[str, list[str]] = {}
+        self.v2_types: list[str] = []
+        self.n_v2 = None
+        self.pending = None  # (system, announced count) of the RINEX 3 obs-types record being read
+
+    def _check_pending(self, i):
+        if self.pending and len(self.types[self.pending[0]]) != self.pending[1]:
+            raise DataFileError(self.path, f"'SYS / # / OBS TYPES' for {self.pending[0]} announces "
+                                f"{self.pending[1]} types, lists {len(self.types[self.pending[0]])}", i)
+
+    def read(self, line, i):
+        label, info, path = line[60:80].strip(), self.info, self.path
         if label == "MARKER NAME":
             info["marker"] = line[:60].strip()
         elif label == "REC # / TYPE / VERS":
@@ -200,28 +197,48 @@ def read_header(lines, path):
             info["tsys"] = line[48:51].strip()
         elif label == "RCV CLOCK OFFS APPL":
             info["applied"] = _num(line[:6], path, i, "RCV CLOCK OFFS APPL", 0.0) == 1
-        elif label == "# / TYPES OF OBSERV" and version < 3:
+        elif label == "# / TYPES OF OBSERV" and self.version < 3:
             if line[:6].strip():
-                n_v2 = int(_num(line[:6], path, i, "number of observation types"))
-            elif n_v2 is None:
+                self.n_v2 = int(_num(line[:6], path, i, "number of observation types"))
+            elif self.n_v2 is None:
                 raise DataFileError(path, "'# / TYPES OF OBSERV' continuation line before its first line", i)
-            v2_types += line[6:60].split()
-        elif label == "SYS / # / OBS TYPES" and version >= 3:
-            sys = line[0:1]
-            if sys.strip():
-                if pending and len(types[pending[0]]) != pending[1]:
-                    raise DataFileError(path, f"'SYS / # / OBS TYPES' for {pending[0]} announces {pending[1]} "
-                                        f"types, lists {len(types[pending[0]])}", i)
-                pending = (sys, int(_num(line[3:6], path, i, "number of observation types")))
-                types[sys] = []
-            elif pending is None:
-                raise DataFileError(path, "'SYS / # / OBS TYPES' continuation line before its first line", i)
-            codes = line[7:58].split()
-            bad = [c for c in codes if len(c) != 3]
-            if bad:
-                raise DataFileError(path, f"observation type {bad[0]!r}: expected 3 characters (e.g. C1C)", i)
-            types[pending[0]] += codes
-    raise DataFileError(path, "no 'END OF HEADER' line: truncated header", len(lines))
+            self.v2_types += line[6:60].split()
+        elif label == "SYS / # / OBS TYPES" and self.version >= 3:
+            self._obs_types(line, i)
+
+    def _obs_types(self, line, i):
+        sys = line[0:1]
+        if sys.strip():
+            self._check_pending(i)
+            self.pending = (sys, int(_num(line[3:6], self.path, i, "number of observation types")))
+            self.types[sys] = []
+        elif self.pending is None:
+            raise DataFileError(self.path, "'SYS / # / OBS TYPES' continuation line before its first line", i)
+        codes = line[7:58].split()
+        bad = [c for c in codes if len(c) != 3]
+        if bad:
+            raise DataFileError(self.path, f"observation type {bad[0]!r}: expected 3 characters (e.g. C1C)", i)
+        self.types[self.pending[0]] += codes
+
+    def finish(self, i) -> ObsHeader:
+        path, info = self.path, self.info
+        if self.version < 3:
+            if self.n_v2 is None:
+                raise DataFileError(path, "missing '# / TYPES OF OBSERV' header record", i)
+            if len(self.v2_types) != self.n_v2:
+                raise DataFileError(path, f"'# / TYPES OF OBSERV' announces {self.n_v2} types, lists "
+                                    f"{len(self.v2_types)}", i)
+            systems = {"G", "R", "E", "S", "C", "J", "I"} if self.file_sys == "M" else {self.file_sys}
+            self.types = {s: [_v2_code(s, c, self.version) for c in self.v2_types] for s in sorted(systems)}
+        elif not self.types:
+            raise DataFileError(path, "missing 'SYS / # / OBS TYPES' header record", i)
+        self._check_pending(i)
+        tsys = info["tsys"] or {"C": "BDT", "E": "GAL"}.get(self.file_sys, "GPS")
+        if tsys not in SUPPORTED_TIME_SYSTEMS:
+            raise DataFileError(path, f"time system {tsys!r} of 'TIME OF FIRST OBS' is not supported "
+                                f"(expected {', '.join(SUPPORTED_TIME_SYSTEMS)})")
+        return ObsHeader(self.version, self.file_sys, info["marker"], info["receiver"], info["antenna"],
+                         info["pos"], info["delta"], self.types, tsys, info["interval"], info["applied"])
 
 
 def _sat_id(text: str, path, line: int, default: str) -> str:

@@ -120,6 +120,7 @@ def _columns(obs: ObsFile):
         if not known_any:
             skipped_systems[sys] = {"satellites": len(so.sats),
                                     "observations": int(np.isfinite(so.values).sum())}
+    skipped_codes = {k: v for k, v in skipped_codes.items() if k[0] not in skipped_systems}
     return feeds, skipped_codes, skipped_systems
 
 
@@ -134,25 +135,8 @@ def build(obs: ObsFile, nav_paths=(), reference=None, reference_source=None) -> 
     signals = [n for n in sigmod.SIGNALS if n in feeds]
     systems = sorted({sigmod.get(n).system for n in signals}, key=SYSTEM_ORDER.find)
     sats = sorted({s for sys in systems for s in obs.systems[sys].sats}, key=_sat_key)
-    col = {s: i for i, s in enumerate(sats)}
-    m, n_s = obs.t.size, len(sats)
-    ds: dict[str, np.ndarray] = {}
-    first_code = np.full((m, n_s), np.nan)
-    for name in signals:
-        arrays = {k: np.full((m, 1, n_s), np.nan) for k in ("code", "carrier", "doppler", "cn0")}
-        lli = np.zeros((m, 1, n_s), np.uint8)
-        for kind, sources in feeds[name].items():
-            for sys, k in sources:
-                so = obs.systems[sys]
-                cols = [col[s] for s in so.sats]
-                arrays[kind][:, 0, cols] = so.values[..., k]
-                if kind == "carrier":
-                    lli[:, 0, cols] = so.lli[..., k]
-        for kind, a in arrays.items():
-            ds[f"gnss/obs/{name}/{kind}"] = a
-        ds[f"gnss/obs/{name}/lli"] = lli
-        fill = np.isnan(first_code)
-        first_code[fill] = arrays["code"][:, 0][fill]
+    m = obs.t.size
+    ds, first_code = _signal_arrays(obs, feeds, signals, sats)
     if reference is None:
         reference, reference_source = header_reference(obs)
     report = {"epochs": m, "span_s": float(obs.t[-1]), "signals": signals, "satellites": len(sats),
@@ -187,6 +171,30 @@ def build(obs: ObsFile, nav_paths=(), reference=None, reference_source=None) -> 
                                           "rinex_version": hdr.version}),
              "import_report": json.dumps(report)}
     return Imported(ds, attrs, group_attrs, report)
+
+
+def _signal_arrays(obs, feeds, signals, sats):
+    """{/gnss/obs/<signal>/<kind>: (M, 1, S)} and each satellite-epoch's first code (M, S) m in signal order."""
+    col = {s: i for i, s in enumerate(sats)}
+    m, n_s = obs.t.size, len(sats)
+    ds: dict[str, np.ndarray] = {}
+    first_code = np.full((m, n_s), np.nan)
+    for name in signals:
+        arrays = {k: np.full((m, 1, n_s), np.nan) for k in ("code", "carrier", "doppler", "cn0")}
+        lli = np.zeros((m, 1, n_s), np.uint8)
+        for kind, sources in feeds[name].items():
+            for sys, k in sources:
+                so = obs.systems[sys]
+                cols = [col[s] for s in so.sats]
+                arrays[kind][:, 0, cols] = so.values[..., k]
+                if kind == "carrier":
+                    lli[:, 0, cols] = so.lli[..., k]
+        for kind, a in arrays.items():
+            ds[f"gnss/obs/{name}/{kind}"] = a
+        ds[f"gnss/obs/{name}/lli"] = lli
+        fill = np.isnan(first_code)
+        first_code[fill] = arrays["code"][:, 0][fill]
+    return ds, first_code
 
 
 def _satellites(obs, nav_paths, sats, signals, first_code, reference, report):
