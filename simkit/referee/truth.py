@@ -15,7 +15,7 @@ import numpy as np
 
 
 from .. import frames
-from ..io import TRUTH_CORE, Truth, has, open_dataset, read_reference
+from ..io import TRUTH_CORE, Truth, has, open_dataset, read_reference, reference_truth
 from ..io import read_truth as read_file_truth
 from ..solution import parse_point
 from . import quat
@@ -28,7 +28,7 @@ def read_truth(path, t_min: float | None = None, t_max: float | None = None) -> 
     samples that bracket that span are read (bounded memory for long files)."""
     with open_dataset(path) as ds:
         if not has(ds, "truth", "t") and read_reference(ds) is not None:
-            return static_reference(ds)
+            return reference_truth(ds)
         missing = [k for k in ("t",) + TRUTH_CORE if not has(ds, "truth", k)]
         if missing:
             raise RefereeInputError(path, f"no /truth/{missing[0]} dataset: scoring needs the truth trajectory")
@@ -43,18 +43,6 @@ def truth_source(path) -> str:
             return "/truth"
         ref = read_reference(ds)
         return "none" if ref is None else f"/reference ({ref[2]}: {ref[1]})"
-
-
-def static_reference(ds) -> Truth:
-    """The static /reference of a real file as a truth over its GNSS epochs: the position, zero velocity, and an
-    identity attitude that only carries the zero lever arm of its one antenna (an attitude is never scored
-    against it: :func:`simkit.api.score` refuses)."""
-    pos, _, _ = read_reference(ds)
-    t = ds["gnss/t"][:]
-    span = np.array([t[0], t[-1] if t[-1] > t[0] else t[0] + 1.0])
-    lever = ds["gnss/antennas/lever_arm_b"][:] if "gnss/antennas/lever_arm_b" in ds else np.zeros((1, 3))
-    return Truth(span, np.tile(pos, (2, 1)), np.zeros((2, 3)), np.tile([0.0, 0.0, 0.0, 1.0], (2, 1)),
-                 np.zeros((2, 3)), lever)
 
 
 def overlap(truth: Truth, t: np.ndarray, where: str = "estimate") -> np.ndarray:
