@@ -223,3 +223,10 @@ def test_navigation_of_another_day_is_one_line(tmp_path):
     with pytest.raises(DataFileError, match=r"no broadcast record is valid during the observations \(2016-06-06 "
                                             r"10:59:43 to .*covers .*2022-06-08"):
         importer.import_rinex(_write(tmp_path), [kms3_nav])
+
+
+def test_a_file_of_systems_simkit_does_not_know_is_one_line(tmp_path):
+    header = HEADER[:4] + [_h("R    2 C1C L1C", "SYS / # / OBS TYPES")] + HEADER[6:]
+    body = ["> 2016 06 06 11 00 00.0000000  0  1", "R05  21000000.123 7 110355000.456 7"]
+    with pytest.raises(DataFileError, match="no observation of a signal simkit knows .* the file has R: C1C L1C"):
+        importer.import_rinex(_write(tmp_path, header, body))
