@@ -173,6 +173,7 @@ def score_labelled(path, estimate, spec=None, solution=None, point=None):
     import numpy as np
 
     from . import referee
+    from .referee.truth import truth_source
 
     if isinstance(spec, (str, bytes)) or hasattr(spec, "__fspath__"):
         spec = referee.load_spec(spec)
@@ -188,7 +189,14 @@ def score_labelled(path, estimate, spec=None, solution=None, point=None):
     finite = np.asarray(sol.t, dtype=float)[np.isfinite(sol.t)]
     span = (finite.min(), finite.max()) if finite.size else (None, None)
     truth = referee.read_truth(path, *span)    # only the truth the estimate needs
-    return referee.score(truth, sol, spec, where=str(label if sol is estimate else estimate), path=path), label
+    source = truth_source(path)
+    if source.startswith("/reference") and (sol.quat_nb is not None or sol.euler is not None):
+        raise ScenarioError(str(estimate if sol is not estimate else label),
+                            f"has an attitude, but {path} has no /truth, only a reference position: "
+                            "its attitude cannot be scored")
+    sc = referee.score(truth, sol, spec, where=str(label if sol is estimate else estimate), path=path)
+    sc.meta["truth"] = source
+    return sc, label
 
 
 def check_validate(n_random: int, random_stride: int) -> None:

@@ -177,7 +177,7 @@ LAYERS = [
     {"attitude"},
     {"estimators"},
     {"referee"},
-    {"export"},
+    {"export", "realdata"},
     {"plots"},
     {"campaign"},
     {"api"},

@@ -42,7 +42,8 @@ def broadcast_ionosphere(ds, p):
 
 
 def spp_fixes(ds, p):
-    """Single-point fixes of antenna ``p['antenna']`` from /gnss/obs (first tracked signal per satellite)."""
+    """Single-point fixes of antenna ``p['antenna']`` from /gnss/obs (first tracked signal per satellite, or the
+    ionosphere-free combination of its first two signals with ``p['ionosphere'] = 'iono-free'``)."""
     g = read_gnss(ds, antennas=antenna(ds, p), obs=("code", "doppler"))
     code = doppler = None
     for j, sig in enumerate(g.signals):
@@ -53,11 +54,42 @@ def spp_fixes(ds, p):
         take = np.isnan(code).all(0) & ~np.isnan(c).all(0)
         code[:, take], doppler[:, take], wl[take], gd[take] = c[:, take], d[:, take], g.wavelength_m[j], \
             g.group_delay[take, j]
-    iono, why = broadcast_ionosphere(ds, p)
+    if p["ionosphere"] == "iono-free":
+        code, gd, iono, why = ionosphere_free(g)
+    else:
+        iono, why = broadcast_ionosphere(ds, p)
     fx = spp(g.t, code, doppler, wl, g.sat_pos_ecef, g.sat_clock, systems_of(g.sat_id), gd,
              p["elevation_mask_deg"], p["sigma_code_m"], p["sigma_doppler_m_per_s"], iono_coefficients=iono,
              gps_sow=float(ds.attrs["start_gps_sow"]) + g.t)
     return SppFixes(**{**fx.__dict__, "ionosphere": why})
+
+
+def ionosphere_free(g):
+    """Ionosphere-free code (M, S) m of each satellite's first two signals of different frequencies (file order),
+    P_IF = (f1^2 P1 - f2^2 P2) / (f1^2 - f2^2), and its group delay (S,) m by the same combination (0 for GPS
+    L1/L2 T_GD, whose clock is the L1/L2 combination's); NaN where a satellite has one frequency at an epoch.
+    Returns (code, group delay, None, description)."""
+    m, s = next(iter(g.obs["code"].values())).shape
+    systems = _system_of(g.sat_id)
+    freq = 299792458.0 / np.asarray(g.wavelength_m, float)
+    code, gd = np.full((m, s), np.nan), np.zeros(s)
+    pairs = []
+    for sys in sorted(set(systems)):
+        cols = systems == sys
+        have = [j for j, sig in enumerate(g.signals) if np.isfinite(g.obs["code"][sig][:, cols]).any()]
+        pair = next(((a, b) for i, a in enumerate(have) for b in have[i + 1:] if freq[a] != freq[b]), None)
+        if pair is None:
+            continue
+        a, b = pair
+        fa, fb = freq[a] ** 2, freq[b] ** 2
+        pa, pb = g.obs["code"][g.signals[a]][:, cols], g.obs["code"][g.signals[b]][:, cols]
+        code[:, cols] = (fa * pa - fb * pb) / (fa - fb)
+        gd[cols] = (fa * g.group_delay[cols, a] - fb * g.group_delay[cols, b]) / (fa - fb)
+        pairs.append(f"{g.signals[a]}+{g.signals[b]}")
+    if not pairs:
+        raise EstimatorInputError("estimator.ionosphere: iono-free needs code on two frequencies of one system; "
+                                  f"the file has {', '.join(g.signals)}")
+    return code, gd, None, "ionosphere-free code (" + ", ".join(pairs) + ")"
 
 
 def gnss_fixes(ds, p) -> GnssFixes:

@@ -82,6 +82,7 @@ class GnssConfig:
     outages: tuple[Outage, ...]
     ambiguity_max_cycles: int
     iono_coefficients: dict[str, tuple] = field(default_factory=dict)  # "gps"/"bds" -> (alpha, beta) overrides
+    code_error_scale: dict[str, float] = field(default_factory=dict)  # signal -> factor on code noise + multipath
 
 
 def _unit(v, key_section: Section, name: str) -> np.ndarray:
@@ -117,7 +118,8 @@ def parse_config(sec: Section) -> GnssConfig:
         slips=tuple(_slip(s, sigs, len(antennas)) for s in _each(sec.sections("slip"))),
         outages=tuple(_outage(o, len(antennas)) for o in _each(sec.sections("outage"))),
         ambiguity_max_cycles=sec.get("ambiguity_max_cycles", int, 100000, check=in_range(0, 10**8)),
-        iono_coefficients=_ionosphere(sec.section("ionosphere")))
+        iono_coefficients=_ionosphere(sec.section("ionosphere")),
+        code_error_scale=_code_scale(sec.section("code_error_scale"), sigs))
     sec.done()
     return cfg
 
@@ -193,6 +195,18 @@ def _outage(o: Section, n_antennas: int) -> Outage:
     if ants is not None and any(not 0 <= a < n_antennas for a in ants):
         raise o.error("antennas", f"antenna indices must be in [0, {n_antennas - 1}]")
     return Outage(start, end, tuple(sats) if sats is not None else None, tuple(ants) if ants is not None else None)
+
+
+def _code_scale(cs: Section, sigs: list[str]) -> dict:
+    """[gnss.code_error_scale]: signal name -> factor (>= 0) on that signal's code noise and code multipath (a
+    receiver's code tracking: correlator spacing, multipath mitigation; ``simkit twin --fit`` estimates them)."""
+    out = {}
+    for name in sigs:
+        value = cs.get(name, float, None, check=non_negative)
+        if value is not None:
+            out[name] = value
+    cs.done()
+    return out
 
 
 def _ionosphere(io: Section) -> dict:

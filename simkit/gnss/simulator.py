@@ -260,11 +260,13 @@ class _Parts:
         rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
         cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, g.cn0_offset_db)
         sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g))
+        code_scale = cfg.code_error_scale.get(g.name, 1.0)
+        sig_c = sig_c * code_scale
         scale = (atmosphere.reference_frequency(g.system) / g.freq_hz) ** 2
         iono, iono_rate = self.iono[..., cj] * scale, self.iono_rate[..., cj] * scale
         el = self.el[..., cj]
         if self.mp is not None:
-            mp_c = elevation_scale(el, cfg.multipath.code_sigma_m, cfg.multipath.elevation_scale_rad) * \
+            mp_c = elevation_scale(el, cfg.multipath.code_sigma_m * code_scale, cfg.multipath.elevation_scale_rad) * \
                 self.mp[:, :, cj, j, 0]
             mp_p = elevation_scale(el, cfg.multipath.carrier_sigma_m, cfg.multipath.elevation_scale_rad) * \
                 self.mp[:, :, cj, j, 1]

@@ -52,7 +52,8 @@ def _geometry(r, sat):
     d = sat - r[:, None, :]
     rho = np.linalg.norm(d, axis=-1)
     sag = OMEGA_E * (sat[..., 0] * r[:, None, 1] - sat[..., 1] * r[:, None, 0]) / C_LIGHT
-    return rho + sag, d / rho[..., None]
+    with np.errstate(invalid="ignore", divide="ignore"):  # satellites without an orbit: NaN, never used
+        return rho + sag, d / rho[..., None]
 
 
 def _elevation(r, e):
@@ -93,6 +94,8 @@ class _Delays:
 def _solve(a, y, w, mask):
     """Batched weighted least squares; rows with ``mask`` False carry no weight. Returns (x, N^-1, ok): ok False
     where the normal matrix is singular (its smallest eigenvalue under 1e-12 of its largest)."""
+    a = np.where(mask[..., None], a, 0.0)  # a satellite without an orbit has NaN geometry: no weight, no NaN
+    y = np.where(mask, y, 0.0)
     aw = a * np.where(mask, w, 0.0)[..., None]
     n = np.swapaxes(aw, 1, 2) @ a
     eig = np.linalg.eigvalsh(n)

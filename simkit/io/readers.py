@@ -214,3 +214,25 @@ def broadcast_ionosphere(ds):
     systems = [str(x) for x in ds["gnss/iono_systems"][:]]
     alpha, beta = ds["gnss/iono_alpha"][:], ds["gnss/iono_beta"][:]
     return {k: (alpha[i], beta[i]) for i, k in enumerate(systems)}
+
+
+def reference_truth(ds) -> Truth | None:
+    """The static /reference of a real file as a :class:`Truth` over its GNSS epochs (None without one): the
+    position twice (first and last epoch), zero velocity, an identity attitude and zero body rate that only carry
+    the file's antenna lever arms (zero for an imported file); never an attitude truth."""
+    ref = read_reference(ds)
+    if ref is None:
+        return None
+    t = ds["gnss/t"][:]
+    span = np.array([t[0], t[-1] if t[-1] > t[0] else t[0] + 1.0])
+    lever = ds["gnss/antennas/lever_arm_b"][:] if "gnss/antennas/lever_arm_b" in ds else np.zeros((1, 3))
+    return Truth(span, np.tile(ref[0], (2, 1)), np.zeros((2, 3)), np.tile([0.0, 0.0, 0.0, 1.0], (2, 1)),
+                 np.zeros((2, 3)), lever)
+
+
+def read_reference(ds):
+    """(pos_ecef (3,) m, source text, kind) of a real file's /reference (``simkit import``), None without one."""
+    if "reference/pos_ecef" not in ds:
+        return None
+    attrs = ds.group_attrs("reference")
+    return ds["reference/pos_ecef"][:], str(attrs.get("source", "unknown")), str(attrs.get("kind", "static"))

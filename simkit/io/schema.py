@@ -26,6 +26,8 @@ ROOT_ATTRS = {
     "created_utc": "creation time, UTC ISO 8601",
     "scenario_name": "scenario.name",
     "overrides": "the --set overrides applied, JSON list of 'key=value'",
+    "imported_from": "simkit import: the RINEX observation and navigation file names and the RINEX version, JSON",
+    "import_report": "simkit import: what was kept and skipped (codes, systems, events), JSON",
 }
 
 
@@ -135,6 +137,10 @@ _GNSS = [
     _f("gnss/truth/<signal>/sigma_carrier", "f8", ("M", "A", "S"), "m", "", "gnss", "carrier noise sigma"),
     _f("gnss/truth/<signal>/sigma_doppler", "f8", ("M", "A", "S"), "Hz", "", "gnss", "Doppler noise sigma"),
 ]
+_REFERENCE = [
+    _f("reference/pos_ecef", "f8", (3,), "m", "ECEF", "import",
+       "reference position of a real file's antenna (no /truth): source in the group's 'source' attribute"),
+]
 _SOLUTIONS = [
     _f("solutions/<name>/t", "f8", ("K",), "s", "", "estimators", "solution epochs since start"),
     _f("solutions/<name>/pos_ecef", "f8", ("K", 3), "m", "ECEF", "estimators",
@@ -156,14 +162,16 @@ _CAMPAIGN = [
        "campaign index: virtual dataset stacking one dataset of every completed run file (/ written as .)"),
 ]
 
-SCHEMA: tuple[Field, ...] = tuple(_TRUTH + _IMU + _GNSS + _SOLUTIONS + _CAMPAIGN)
+SCHEMA: tuple[Field, ...] = tuple(_TRUTH + _IMU + _GNSS + _REFERENCE + _SOLUTIONS + _CAMPAIGN)
 
 GROUP_ATTRS = {
     "truth": {"rate_hz": "trajectory.rate_hz",
               "log": "a logged trajectory only (trajectory.source): JSON of source, sha256, samples_used, attitude, "
                      "sigma_m, sigma_source, residual_rms_m"},
     "imu": {"rate_hz": "IMU rate", "<parameter>": "the IMU error model parameters (JSON text where not scalar)"},
-    "gnss": {"rate_hz": "gnss.rate_hz"},
+    "gnss": {"rate_hz": "gnss.rate_hz", "receiver": "simkit import: RINEX receiver type",
+             "antenna": "simkit import: RINEX antenna type", "marker": "simkit import: RINEX marker name"},
+    "reference": {"source": "where /reference/pos_ecef comes from (RINEX header or user)", "kind": "static"},
     "solutions/<name>": {"config": "the estimator configuration, JSON"},
 }
 

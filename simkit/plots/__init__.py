@@ -8,6 +8,7 @@ from .command_figures import allan_figure, sky_figure, validation_figures
 from .common import image_format, require_matplotlib, staged_directory
 from .file_figures import FIGURES, file_figures
 from .score_figures import score_figures
+from .twin_figures import twin_figures
 
 __all__ = ["FIGURES", "allan_figure", "file_figures", "image_format", "require_matplotlib", "score_figures",
-           "sky_figure", "staged_directory", "validation_figures"]
+           "sky_figure", "staged_directory", "twin_figures", "validation_figures"]

@@ -104,8 +104,9 @@ def _state_lines(sc: Score) -> list[str]:
 def to_markdown(sc: Score, label: str = "", truth: str = "") -> str:
     """A Markdown report: statistics table, convergence, NEES/NIS, checks and the verdict."""
     m = sc.meta
+    used = f" {m['truth']}" if "truth" in m else ""
     out = [f"# Score of {label or 'estimate'}", "",
-           f"Truth: {truth or '-'}; {m['epochs_scored']} epochs scored from {m['t_first_s']:.2f} s to "
+           f"Truth: {truth or '-'}{used}; {m['epochs_scored']} epochs scored from {m['t_first_s']:.2f} s to "
            f"{m['t_last_s']:.2f} s ({m['epochs_outside_truth']} outside the truth span left out). Errors are "
            f"estimate - truth{_where(m)}.", "",
            *([f"Not estimated (left out): {', '.join(m['not_estimated'])}.", ""] if m.get("not_estimated") else []),

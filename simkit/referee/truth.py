@@ -11,7 +11,7 @@ import numpy as np
 
 
 from .. import frames
-from ..io import TRUTH_CORE, Truth, has, open_dataset, truth_at  # noqa: F401 (truth_at: the referee's API)
+from ..io import TRUTH_CORE, Truth, has, open_dataset, read_reference, reference_truth, truth_at  # noqa: F401
 from ..io import read_truth as read_file_truth
 from ..solution import parse_point
 from .errors import RefereeInputError
@@ -22,10 +22,22 @@ def read_truth(path, t_min: float | None = None, t_max: float | None = None) -> 
     present, the antenna lever arms) of the simkit file ``path``; with ``t_min`` / ``t_max`` (s) only the
     samples that bracket that span are read (bounded memory for long files)."""
     with open_dataset(path) as ds:
+        if not has(ds, "truth", "t") and read_reference(ds) is not None:
+            return reference_truth(ds)
         missing = [k for k in ("t",) + TRUTH_CORE if not has(ds, "truth", k)]
         if missing:
             raise RefereeInputError(path, f"no /truth/{missing[0]} dataset: scoring needs the truth trajectory")
         return read_file_truth(ds, span=(t_min, t_max))
+
+
+def truth_source(path) -> str:
+    """Which truth :func:`read_truth` uses for the file ``path``: "/truth", or "/reference (<its source>)" for a
+    real file (``simkit import``), which has no /truth."""
+    with open_dataset(path) as ds:
+        if has(ds, "truth", "t"):
+            return "/truth"
+        ref = read_reference(ds)
+        return "none" if ref is None else f"/reference ({ref[2]}: {ref[1]})"
 
 
 def overlap(truth: Truth, t: np.ndarray, where: str = "estimate") -> np.ndarray:

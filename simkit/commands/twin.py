@@ -1,0 +1,51 @@
+"""``simkit twin OBS --nav NAV [-o DIR] [--fit]``: simulate the receiver of a real RINEX file and compare the two
+(DIR/real.h5, twin.h5, fidelity.json, report.md, figures; with --fit also twin_fit.h5 and fitted.toml).
+See docs/real_data.md."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+
+def add_parser(sub):
+    p = sub.add_parser("twin", help="simulate the twin of a real receiver file and measure their differences",
+                       description="Import a RINEX observation file, simulate the same static receiver (reference "
+                                   "position, epochs, signals, broadcast sky, inferred elevation mask) and compare "
+                                   "tracking, C/N0, code noise and multipath, carrier and Doppler noise and slips; "
+                                   "--fit estimates simkit's [gnss] error parameters from the real file.")
+    p.add_argument("obs", help="RINEX observation file (2.1x, 3.0x, 4.00; plain, gzip or Hatanaka)")
+    p.add_argument("--nav", action="append", default=[], metavar="NAV", required=True,
+                   help="RINEX 3/4 navigation file (repeatable)")
+    p.add_argument("-o", "--out", default="twin", help="output folder (created; default ./twin)")
+    p.add_argument("--fit", action="store_true", help="fit the [gnss] error parameters and run the calibrated twin")
+    p.add_argument("--reference", metavar="X,Y,Z", help="receiver position, m ECEF (default: the header's)")
+    p.add_argument("--seed", type=int, default=1, help="seed of the twin (default 1)")
+    p.add_argument("--no-plots", action="store_true", help="no figures (they need the 'plot' extra)")
+    return p
+
+
+def run(args) -> int:
+    from ..errors import OutputError
+    from ..io.output import check_output
+    from ..realdata import importer, twin
+
+    for path in [args.obs, *args.nav]:
+        if not Path(path).is_file():
+            raise OutputError(path, "no such file")
+    out = check_output(args.out, [args.obs, *args.nav], option="-o", folder=True, parents=True)
+    if not args.no_plots:
+        from ..plots import require_matplotlib
+
+        require_matplotlib("twin (or --no-plots)")
+    reference, source = importer.parse_reference(args.reference, None)
+    fid = twin.run_twin(args.obs, args.nav, out, fit=args.fit, seed=args.seed, reference=reference,
+                        reference_source=source)
+    figures = []
+    if not args.no_plots:
+        from ..plots import twin_figures
+
+        figures = twin_figures(fid, out)
+    report = twin.report_markdown(fid, figures)
+    (out / "report.md").write_text(report)
+    sys.stdout.write(report)
+    return 0

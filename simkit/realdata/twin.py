@@ -1,0 +1,415 @@
+"""``simkit twin``: simulate the receiver of a real RINEX file and measure how far the simulation is from it.
+
+The twin is a simkit scenario built from the real file: a static antenna at the reference position (header
+APPROX POSITION or the given one), the same first epoch, span and interval, the same signals, the broadcast sky of
+the same navigation files, and the elevation mask inferred from the data (the lowest elevation tracked, floored to
+a whole degree). Its [gnss] error parameters are simkit's defaults, or with ``fit`` the ones estimated from the
+real file (:func:`fit_parameters`): the calibrated twin.
+
+Both files go through the same statistics (:mod:`.fidelity`); the comparison is returned as a JSON-ready dict.
+A moving receiver (no reference position) is not twinned here: its trajectory would have to come from a
+solution of the real file.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .. import frames, gpstime
+from ..earth import C_LIGHT
+from ..errors import InputError
+from ..gnss import noise as noise_model
+from ..gnss import signals as sigmod
+from . import fidelity, importer
+
+KINDS = ("code", "carrier", "doppler", "cn0", "lli")
+# simkit's [gnss] defaults that the fit changes (docs/gnss.md)
+DEFAULTS = {"cn0_zenith_dbhz": 45.0, "rolloff_db": 10.0, "dll_bandwidth_hz": 1.0, "pll_bandwidth_hz": 15.0,
+            "fll_bandwidth_hz": 2.0, "correlator_spacing_chips": 0.5, "integration_time_s": 0.02,
+            "mp_code_sigma_m": 1.0, "mp_carrier_sigma_m": 0.01, "mp_elevation_scale_deg": 20.0,
+            "mp_correlation_time_s": 30.0,
+            "slip_rate_per_h": 0.0}
+
+
+def real_arrays(imported: importer.Imported) -> dict:
+    """{t, sat_id, signals, freq, obs {kind: {signal: (M, S)}}, sat_pos, reference} of an imported file."""
+    d = imported.datasets
+    signals = [str(s) for s in d["gnss/signals"]]
+    return {"t": d["gnss/t"], "sat_id": [str(s) for s in d["gnss/sat_id"]], "signals": signals,
+            "freq": d["gnss/frequency_hz"], "sat_pos": d["gnss/sat_pos_ecef"],
+            "obs": {k: {s: d[f"gnss/obs/{s}/{k}"][:, 0] for s in signals} for k in KINDS},
+            "reference": d.get("reference/pos_ecef"), "start": (int(imported.attrs["start_gps_week"]),
+                                                                 float(imported.attrs["start_gps_sow"]))}
+
+
+def file_arrays(path) -> dict:
+    """The same dict as :func:`real_arrays` for a simkit file (antenna 0)."""
+    from ..io import open_dataset, read_gnss
+
+    with open_dataset(path) as ds:
+        g = read_gnss(ds, antennas=0, obs=KINDS)
+        return {"t": g.t, "sat_id": [str(s) for s in g.sat_id], "signals": list(g.signals),
+                "freq": C_LIGHT / g.wavelength_m, "sat_pos": g.sat_pos_ecef, "obs": g.obs, "reference": None,
+                "start": (int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]))}
+
+
+def inferred_mask_deg(real: dict, reference) -> float:
+    """The lowest elevation (deg) at which the receiver tracked a satellite, floored to a whole degree (>= 0)."""
+    el = np.degrees(fidelity.elevations(real["sat_pos"], reference))
+    on = fidelity.tracked(real["obs"]) & np.isfinite(el)
+    if not on.any():
+        raise InputError("twin", "no tracked satellite has a broadcast orbit: cannot infer the elevation mask")
+    return float(max(0.0, np.floor(np.min(el[on]))))
+
+
+def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, seed: int) -> dict:
+    """The twin's scenario (a dict for :func:`simkit.run`)."""
+    week, sow = real["start"]
+    t = real["t"]
+    interval = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    start = gpstime.gps_to_utc(week, sow)
+    lla = frames.ecef_to_lla(np.asarray(reference, float)[None])[0]
+    p = {**DEFAULTS, **params}
+    return {
+        "scenario": {"name": "twin", "start": start.isoformat(timespec="microseconds").replace("+00:00", "Z"),
+                     "duration_s": float(t[-1]), "seed": int(seed)},
+        "trajectory": {"rate_hz": 1.0 / interval,
+                       "origin": {"lat_deg": float(np.degrees(lla[0])), "lon_deg": float(np.degrees(lla[1])),
+                                  "height_m": float(lla[2])},
+                       "initial": {"speed_m_per_s": 0.0, "heading_deg": 0.0},
+                       "segment": [{"kind": "static", "duration_s": float(t[-1])}]},
+        "gnss": {"rate_hz": 1.0 / interval, "elevation_mask_deg": mask_deg, "signals": list(real["signals"]),
+                 "cn0_zenith_dbhz": p["cn0_zenith_dbhz"], "slip_rate_per_h": p["slip_rate_per_h"],
+                 "constellation": [{"source": str(Path(n).resolve())} for n in nav_paths],
+                 "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0], "rolloff_db": p["rolloff_db"]}],
+                 "noise": {"dll_bandwidth_hz": p["dll_bandwidth_hz"], "pll_bandwidth_hz": p["pll_bandwidth_hz"],
+                           "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
+                 "code_error_scale": dict(p.get("code_error_scale", {})),
+                 "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
+                               "elevation_scale_deg": p["mp_elevation_scale_deg"],
+                               "correlation_time_s": p["mp_correlation_time_s"]}},
+    }
+
+
+def statistics(arr: dict, el: np.ndarray) -> dict:
+    """The per-file statistics of :mod:`.fidelity` over elevation bins (``el`` (M, S) rad for its columns)."""
+    obs, signals, freq, t = arr["obs"], arr["signals"], np.asarray(arr["freq"]), arr["t"]
+    on = fidelity.tracked(obs)
+    mp = fidelity.multipath(obs, signals, freq, t)
+    cn = fidelity.carrier_noise(obs, signals, freq, t)
+    dop = fidelity.doppler_residual(obs, signals, freq, t)
+    return {
+        "tracked_per_epoch": {"mean": float(on.sum(1).mean()), "min": int(on.sum(1).min()),
+                              "max": int(on.sum(1).max())},
+        "cn0_dbhz": {s: fidelity.by_elevation(obs["cn0"][s], el) for s in signals},
+        "code_noise_m": {s: fidelity.by_elevation(mp[s], el, stat="std") for s in signals},
+        "code_noise_robust_m": {s: fidelity.by_elevation(mp[s], el, stat="robust_std") for s in signals},
+        "carrier_noise_m": {k: fidelity.robust_std(v) for k, v in cn.items()},
+        "doppler_noise_hz": {k: fidelity.robust_std(v) for k, v in dop.items()},
+        "slips_per_hour": fidelity.slips_per_hour(obs, signals, t),
+        "_series": {"mp": mp, "cn": cn, "dop": dop},
+    }
+
+
+def _align(real: dict, twin: dict):
+    """Twin column of each real satellite, real row of each twin epoch (-1 where absent)."""
+    col = {s: i for i, s in enumerate(twin["sat_id"])}
+    real_cols = np.array([col.get(s, -1) for s in real["sat_id"]])
+    dt = float(np.median(np.diff(twin["t"]))) if twin["t"].size > 1 else 1.0
+    tol = 0.25 * dt   # receivers that tag epochs off the grid (42.3999998 s) still pair with the grid epoch
+    rows = np.clip(np.searchsorted(real["t"], twin["t"]), 1, max(real["t"].size - 1, 1))
+    rows = np.where(np.abs(real["t"][rows - 1] - twin["t"]) < np.abs(real["t"][rows] - twin["t"]), rows - 1, rows)
+    rows = np.where(np.abs(real["t"][rows] - twin["t"]) < tol, rows, -1)
+    return real_cols, rows
+
+
+def on_twin_grid(real: dict, twin: dict) -> dict:
+    """The real arrays re-indexed onto the twin's epochs and satellites (NaN / 0 where the real file has none)."""
+    cols, rows = _align(real, twin)
+    m, s = twin["t"].size, len(twin["sat_id"])
+    keep_c = cols >= 0
+    keep_r = rows >= 0
+    obs = {}
+    for kind in KINDS:
+        obs[kind] = {}
+        for sig in real["signals"]:
+            fill = 0 if kind == "lli" else np.nan
+            a = np.full((m, s), fill, dtype=np.uint8 if kind == "lli" else float)
+            src = real["obs"][kind][sig][rows[keep_r]][:, keep_c]
+            a[np.ix_(np.flatnonzero(keep_r), cols[keep_c])] = src
+            obs[kind][sig] = a
+    return {**real, "t": twin["t"], "sat_id": twin["sat_id"], "obs": obs, "sat_pos": twin["sat_pos"],
+            "not_in_twin": [real["sat_id"][i] for i in np.flatnonzero(~keep_c)]}
+
+
+def compare(real: dict, twin: dict, reference, mask_deg: float) -> dict:
+    """Real (on the twin's grid) against twin: tracking, C/N0, code noise, carrier and Doppler noise, slips."""
+    el = fidelity.elevations(twin["sat_pos"], reference)
+    rs, ts = statistics(real, el), statistics(twin, el)
+    above = np.degrees(el) >= mask_deg
+    r_on, t_on = fidelity.tracked(real["obs"]), fidelity.tracked(twin["obs"])
+    agree = float(np.mean(r_on[above] == t_on[above])) if above.any() else None
+    out = {"elevation_bins_deg": fidelity.ELEVATION_EDGES_DEG.tolist(), "mask_deg": mask_deg,
+           "visibility_agreement": agree,
+           "satellite_epochs_above_mask": int(above.sum()),
+           "tracked_real_not_twin": int((r_on & ~t_on & above).sum()),
+           "tracked_twin_not_real": int((t_on & ~r_on & above).sum()),
+           "tracked_below_mask_real": int((r_on & ~above).sum()),
+           "disagreement_max_elevation_deg": float(np.degrees(el[above & (r_on != t_on)]).max())
+           if (above & (r_on != t_on)).any() else None,
+           "tracked_series": {"t": twin["t"].tolist(), "real": r_on.sum(1).tolist(), "twin": t_on.sum(1).tolist()},
+           "real": {k: v for k, v in rs.items() if k != "_series"},
+           "twin": {k: v for k, v in ts.items() if k != "_series"},
+           "satellites_without_orbit": real.get("not_in_twin", [])}
+    out["cn0_rms_difference_dbhz"] = {s: _rms_diff(rs["cn0_dbhz"][s], ts["cn0_dbhz"][s]) for s in real["signals"]}
+    out["code_noise_ratio"] = {s: _ratios(ts["code_noise_m"][s], rs["code_noise_m"][s]) for s in real["signals"]}
+    return out
+
+
+def _rms_diff(a, b):
+    d = [x - y for x, y in zip(a, b) if x is not None and y is not None]
+    return float(np.sqrt(np.mean(np.square(d)))) if d else None
+
+
+def _ratios(twin, real):
+    return [None if x is None or y is None or y == 0 else float(x / y) for x, y in zip(twin, real)]
+
+
+def fit_parameters(real: dict, reference) -> dict:
+    """simkit [gnss] error parameters estimated from the real file (the calibrated twin's).
+
+    * C/N0: least squares of C/N0 = cn0_zenith + signal offset - rolloff ((90 - el) / 90)^2 (the simulator's
+      model, :mod:`simkit.gnss.noise`) over every observation with a signal strength; defaults when none.
+    * Code: the code-minus-carrier scatter per signal and elevation bin against the simulator's code error
+      f_s sqrt(DLL jitter(C/N0(el))^2 + (sigma_h exp(-el / el0))^2): one multipath profile (sigma_h, el0) and a
+      per-signal factor f_s (``[gnss.code_error_scale]``: a receiver's correlators and multipath mitigation differ
+      by code), in log least squares (:func:`_fit_code`); the multipath correlation time from the lag-one
+      autocorrelation of the multipath series.
+    * Carrier and Doppler (:func:`rescale`, after a first twin): the carrier error terms (PLL jitter, carrier
+      multipath) and the FLL jitter scaled by the ratio of the real to the twin's measured carrier noise
+      (geometry-free third differences) and Doppler noise: both terms are linear in these scales.
+    * Slips: loss-of-lock flags per tracked hour.
+    """
+    el = fidelity.elevations(real["sat_pos"], reference)
+    st = statistics(real, el)
+    p = dict(DEFAULTS)
+    notes = []
+    signals = real["signals"]
+    sigs = [sigmod.get(s) for s in signals]
+    rows_x, rows_y = [], []
+    for g in sigs:
+        c = real["obs"]["cn0"][g.name]
+        ok = np.isfinite(c) & np.isfinite(el)
+        if ok.any():
+            x = ((np.pi / 2 - el[ok]) / (np.pi / 2)) ** 2
+            rows_x.append(np.column_stack([np.ones(x.size), -x]))
+            rows_y.append(c[ok] - g.cn0_offset_db)
+    if rows_x:
+        sol = np.linalg.lstsq(np.vstack(rows_x), np.concatenate(rows_y), rcond=None)[0]
+        p["cn0_zenith_dbhz"] = float(np.clip(sol[0], 10.0, 70.0))
+        p["rolloff_db"] = float(max(sol[1], 0.0))
+    else:
+        notes.append("no signal-strength observations: C/N0 model left at the defaults")
+    edges = fidelity.ELEVATION_EDGES_DEG
+    centres = np.radians(0.5 * (edges[:-1] + edges[1:]))
+    dt = float(np.median(np.diff(real["t"]))) if real["t"].size > 1 else 1.0
+
+    def cn0_at(g, e):
+        return noise_model.cn0_dbhz(np.pi / 2 - e, p["cn0_zenith_dbhz"], p["rolloff_db"], g.cn0_offset_db)
+
+    code = _fit_code(st, sigs, centres, lambda g, c: noise_model.dll_sigma_m(
+        cn0_at(g, c), g.chip_length_m, p["dll_bandwidth_hz"], p["correlator_spacing_chips"], p["integration_time_s"]))
+    if code is None:
+        notes.append("too few code-minus-carrier bins: code noise and multipath left at the defaults")
+    else:
+        p["mp_code_sigma_m"], p["mp_elevation_scale_deg"], p["code_error_scale"] = code
+    rho = _lag_one(st["_series"]["mp"])
+    if rho is not None and 0.0 < rho < 1.0:
+        p["mp_correlation_time_s"] = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0))
+    rates = [v for v in st["slips_per_hour"].values() if v is not None]
+    p["slip_rate_per_h"] = float(np.mean(rates)) if rates else 0.0
+    p["_notes"] = notes
+    return p
+
+
+def rescale(p: dict, result: dict) -> dict:
+    """``p`` with the carrier, Doppler and per-signal code terms scaled by real / twin of a twin run's
+    comparison ``result`` (median over pairs, signals or elevation bins): PLL and FLL bandwidths by the squared
+    ratio (jitter ~ sqrt(bandwidth)), carrier multipath and the code factors by the ratio."""
+    p = dict(p)
+    real, twin = result["real"], result["twin"]
+    r = [real["carrier_noise_m"][k] / twin["carrier_noise_m"][k] for k in real["carrier_noise_m"]
+         if np.isfinite(real["carrier_noise_m"][k]) and twin["carrier_noise_m"].get(k)]
+    if r:
+        p["pll_bandwidth_hz"] = float(np.clip(p["pll_bandwidth_hz"] * np.median(r) ** 2, 0.1, 100.0))
+        p["mp_carrier_sigma_m"] = float(p["mp_carrier_sigma_m"] * np.median(r))
+    r = [real["doppler_noise_hz"][k] / twin["doppler_noise_hz"][k] for k in real["doppler_noise_hz"]
+         if np.isfinite(real["doppler_noise_hz"][k]) and twin["doppler_noise_hz"].get(k)]
+    if r:
+        p["fll_bandwidth_hz"] = float(np.clip(p["fll_bandwidth_hz"] * np.median(r) ** 2, 0.05, 100.0))
+    scales = dict(p.get("code_error_scale", {}))
+    for s, ratios in result["code_noise_ratio"].items():
+        ok = [x for x in ratios if x]
+        if ok:
+            scales[s] = float(scales.get(s, 1.0) / np.median(ok))
+    p["code_error_scale"] = scales
+    return p
+
+
+def _fit_code(st, sigs, centres, dll):
+    """(sigma_h m, el0 deg, {signal: factor}) minimising the log misfit of the code scatter per signal and
+    elevation bin to f_s sqrt(dll_s(el)^2 + sigma_h^2 exp(-2 el / el0)): one multipath profile, one factor per
+    signal (scipy least squares); None with fewer bins than unknowns."""
+    from scipy.optimize import least_squares
+
+    rows = [(k, c, m, dll(g, c)) for k, g in enumerate(sigs)
+            for m, c in zip(st["code_noise_robust_m"][g.name], centres) if m is not None and m > 0]
+    used = sorted({k for k, *_ in rows})
+    if len(rows) < len(used) + 3:
+        return None
+    k_of = np.array([used.index(k) for k, *_ in rows])
+    el = np.array([c for _, c, _, _ in rows])
+    meas = np.log([m for *_, m, _ in rows])
+    white = np.array([w for *_, w in rows])
+
+    def resid(x):
+        sigma_h, el0 = np.exp(x[0]), np.exp(x[1])
+        model = np.exp(x[2:])[k_of] * np.sqrt(white ** 2 + (sigma_h * np.exp(-el / el0)) ** 2)
+        return np.log(model) - meas
+
+    x0 = np.concatenate([[np.log(0.5), np.log(np.radians(20.0))], np.zeros(len(used))])
+    lo = np.concatenate([[np.log(1e-3), np.log(np.radians(1.0))], np.full(len(used), np.log(1e-3))])
+    hi = np.concatenate([[np.log(20.0), np.log(np.radians(90.0))], np.full(len(used), np.log(100.0))])
+    x = least_squares(resid, x0, bounds=(lo, hi)).x
+    return (float(np.exp(x[0])), float(np.degrees(np.exp(x[1]))),
+            {sigs[k].name: float(np.exp(x[2 + i])) for i, k in enumerate(used)})
+
+
+def _lag_one(series: dict):
+    """Pooled lag-one autocorrelation of the multipath series (pairs of consecutive finite values)."""
+    num = den = 0.0
+    for x in series.values():
+        a, b = x[:-1], x[1:]
+        ok = np.isfinite(a) & np.isfinite(b)
+        num += float(np.sum(a[ok] * b[ok]))
+        den += float(np.sum(a[ok] ** 2))
+    return num / den if den > 0 else None
+
+
+def toml_fragment(p: dict) -> str:
+    """The fitted parameters as the [gnss] TOML fragment of a scenario (the calibrated twin)."""
+    lines = ["# simkit twin --fit: [gnss] error parameters estimated from the real file (docs/real_data.md)", "[gnss]",
+             f"cn0_zenith_dbhz = {p['cn0_zenith_dbhz']:.2f}", f"slip_rate_per_h = {p['slip_rate_per_h']:.3f}", "",
+             "[gnss.noise]", 'model = "cn0"', f"dll_bandwidth_hz = {p['dll_bandwidth_hz']:.4f}",
+             f"pll_bandwidth_hz = {p['pll_bandwidth_hz']:.4f}", f"fll_bandwidth_hz = {p['fll_bandwidth_hz']:.4f}", "",
+             "[gnss.multipath]", f"code_sigma_m = {p['mp_code_sigma_m']:.4f}",
+             f"carrier_sigma_m = {p['mp_carrier_sigma_m']:.5f}",
+             f"elevation_scale_deg = {p['mp_elevation_scale_deg']:.2f}",
+             f"correlation_time_s = {p['mp_correlation_time_s']:.1f}", "",
+             "[gnss.code_error_scale]", *(f"{k} = {v:.4f}" for k, v in p.get("code_error_scale", {}).items()), "",
+             "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]", f"rolloff_db = {p['rolloff_db']:.2f}"]
+    return "\n".join(lines) + "\n"
+
+
+def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress):
+    from ..pipeline import run
+
+    run(scenario(real, ref, nav_paths, mask, params, seed), out=path, progress=progress, force=True)
+    twin = file_arrays(path)
+    return compare(on_twin_grid(real, twin), twin, ref, mask)
+
+
+def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
+             reference_source=None, progress: bool = False) -> dict:
+    """Import ``obs_path`` (+ ``nav_paths``), simulate its twin into ``out_dir``/twin.h5 (and with ``fit`` the
+    calibrated twin_fit.h5), compare; returns the fidelity dict (also the content of fidelity.json)."""
+    out_dir = Path(out_dir)
+    if not nav_paths:
+        raise InputError("--nav", "the twin needs the broadcast navigation file(s) of the observation file")
+    imported = importer.import_rinex(obs_path, nav_paths, reference, reference_source)
+    real = real_arrays(imported)
+    ref = real["reference"]
+    if ref is None:
+        raise InputError(str(obs_path), "no reference position (no APPROX POSITION XYZ in the header): give "
+                                        "--reference X,Y,Z; a moving receiver's twin is not supported")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    importer.write(out_dir / "real.h5", imported)
+    mask = inferred_mask_deg(real, ref)
+    result = {"obs": Path(obs_path).name, "nav": [Path(n).name for n in nav_paths],
+              "reference": imported.report["reference"], "epochs": int(real["t"].size),
+              "span_s": float(real["t"][-1]), "signals": real["signals"], "seed": seed}
+    result["default"] = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed, out_dir / "twin.h5", progress)
+    if fit:
+        fitted = fit_parameters(real, ref)
+        result["fit_notes"] = fitted.pop("_notes")
+        fitted = rescale(fitted, result["default"])    # carrier and Doppler terms from the default twin
+        first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, out_dir / "twin_fit.h5", progress)
+        fitted = rescale(fitted, first)                # one refinement of the per-signal code factors
+        result["fitted_parameters"] = fitted
+        (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
+        result["fitted"] = _twin_once(real, ref, nav_paths, mask, fitted, seed + 2, out_dir / "twin_fit.h5",
+                                      progress)
+    (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
+    return result
+
+
+def _fmt(v, digits=2):
+    return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else f"{v:.{digits}f}"
+
+
+def report_markdown(fid: dict, figures=()) -> str:
+    """report.md of a twin: the comparison tables of :func:`compare` for the default (and fitted) twin."""
+    runs = [k for k in ("default", "fitted") if k in fid]
+    base = fid[runs[0]]
+    edges = base["elevation_bins_deg"]
+    bins = [f"{a:g}-{b:g}" for a, b in zip(edges[:-1], edges[1:])]
+    out = [f"# Twin of {fid['obs']}", "",
+           f"Navigation: {', '.join(fid['nav'])}. Reference: {fid['reference']}. {fid['epochs']} epochs over "
+           f"{fid['span_s']:.0f} s; signals {', '.join(fid['signals'])}; elevation mask inferred from the data: "
+           f"{base['mask_deg']:g} deg. Twin: simkit defaults" + (", and the calibrated twin (--fit, "
+                                                                  "fitted.toml)." if "fitted" in fid else "."), ""]
+    out += ["## Tracking", "", "| twin | visibility agreement | satellite-epochs above the mask | tracked real only "
+            "| tracked twin only | highest elevation of a disagreement (deg) | tracked per epoch real / twin |",
+            "|---|---:|---:|---:|---:|---:|---|"]
+    for k in runs:
+        c = fid[k]
+        out.append(f"| {k} | {_fmt(100 * c['visibility_agreement'], 1)} % | {c['satellite_epochs_above_mask']} | "
+                   f"{c['tracked_real_not_twin']} | {c['tracked_twin_not_real']} | "
+                   f"{_fmt(c['disagreement_max_elevation_deg'], 1)} | {_fmt(c['real']['tracked_per_epoch']['mean'], 1)}"
+                   f" / {_fmt(c['twin']['tracked_per_epoch']['mean'], 1)} |")
+    for quantity, title, digits in (("cn0_dbhz", "C/N0 (dB-Hz), mean per elevation bin (deg)", 1),
+                                    ("code_noise_m", "Code noise and multipath sigma (m) per elevation bin (deg), "
+                                     "from the code-minus-carrier", 3)):
+        out += ["", f"## {title}", "", "| signal | file | " + " | ".join(bins) + " |",
+                "|---|---|" + "---:|" * len(bins)]
+        for s in fid["signals"]:
+            out.append(f"| {s} | real | " + " | ".join(_fmt(v, digits) for v in base["real"][quantity][s]) + " |")
+            for k in runs:
+                out.append(f"| {s} | twin ({k}) | " + " | ".join(_fmt(v, digits) for v in fid[k]["twin"][quantity][s])
+                           + " |")
+    out += ["", "C/N0 RMS difference over the bins (dB-Hz): " + "; ".join(
+        f"{k}: " + ", ".join(f"{s} {_fmt(v)}" for s, v in fid[k]["cn0_rms_difference_dbhz"].items()) for k in runs)]
+    out += ["", "Code-noise ratio twin / real per bin: " + "; ".join(
+        f"{k}: {_within(fid[k]['code_noise_ratio'])}" for k in runs)]
+    out += ["", "## Carrier, Doppler, slips", "", "| quantity | real | " + " | ".join(f"twin ({k})" for k in runs)
+            + " |", "|---|---:|" + "---:|" * len(runs)]
+    for key, label, d in (("carrier_noise_m", "carrier noise (m, geometry-free 3rd difference / sqrt 20)", 4),
+                          ("doppler_noise_hz", "Doppler noise (Hz)", 3), ("slips_per_hour", "LLI slips per hour", 2)):
+        for s, v in base["real"][key].items():
+            out.append(f"| {label} {s} | {_fmt(v, d)} | " + " | ".join(_fmt(fid[k]["twin"][key].get(s), d)
+                                                                       for k in runs) + " |")
+    if "fitted_parameters" in fid:
+        out += ["", "## Fitted [gnss] parameters", "", "```toml", toml_fragment(fid["fitted_parameters"]).rstrip(),
+                "```"] + [f"- {n}" for n in fid.get("fit_notes", [])]
+    out += [""] + [f"![{Path(p).stem}]({Path(p).name})" for p in figures]
+    return "\n".join(out) + "\n"
+
+
+def _within(ratios: dict, tol: float = 0.2) -> str:
+    vals = [x for v in ratios.values() for x in v if x is not None]
+    if not vals:
+        return "no bin"
+    inside = sum(abs(x - 1.0) <= tol for x in vals)
+    return f"{inside} of {len(vals)} bins within {100 * tol:g} % (median ratio {np.median(vals):.2f})"

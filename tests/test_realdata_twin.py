@@ -1,0 +1,135 @@
+"""The twin's statistics against closed forms on synthetic series, and ``simkit twin`` on the real KMS3 file."""
+from __future__ import annotations
+
+import json
+import tomllib
+
+import numpy as np
+import pytest
+
+from realdata_helpers import KMS3_NAV, KMS3_OBS
+from simkit.cli import main
+from simkit.gnss import signals as sigmod
+from simkit.realdata import fidelity, twin
+
+L1, L2 = sigmod.get("L1C"), sigmod.get("L2W")
+
+
+def _dual(m=400, s=3, sigma_code=0.3, sigma_phase=0.002, seed=0, dt=1.0):
+    """Code and carrier of L1C and L2W over a smooth range and ionosphere with white noise of known sigma."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(m) * dt
+    rho = 2.2e7 + 500.0 * t[:, None] + 0.01 * t[:, None] ** 2 + 1e5 * np.arange(s)
+    iono1 = 3.0 + 1e-3 * t[:, None] + np.zeros((1, s))
+    obs = {k: {} for k in twin.KINDS}
+    for g in (L1, L2):
+        i = iono1 * (L1.freq_hz / g.freq_hz) ** 2
+        obs["code"][g.name] = rho + i + sigma_code * rng.standard_normal((m, s))
+        phase_m = rho - i + sigma_phase * rng.standard_normal((m, s))
+        obs["carrier"][g.name] = phase_m / g.wavelength_m + rng.integers(-1000, 1000, s)
+        obs["doppler"][g.name] = -(500.0 + 0.02 * t[:, None] + np.zeros((1, s))) / g.wavelength_m \
+            + 0.05 * rng.standard_normal((m, s))
+        obs["cn0"][g.name] = np.full((m, s), 45.0)
+        obs["lli"][g.name] = np.zeros((m, s), np.uint8)
+    return t, obs
+
+
+def test_multipath_combination_cancels_range_ionosphere_and_ambiguity():
+    t, obs = _dual()
+    mp = fidelity.multipath(obs, ["L1C", "L2W"], [L1.freq_hz, L2.freq_hz], t)
+    a = (L1.freq_hz / L2.freq_hz) ** 2
+    # MP1 = P1 - (1 + 2/(a-1)) L1 + 2/(a-1) L2: the code noise plus carrier noise amplified by the coefficients
+    expected = np.hypot(0.3, 0.002 * np.hypot(1 + 2 / (a - 1), 2 / (a - 1)))
+    assert np.nanstd(mp["L1C"]) == pytest.approx(expected, rel=0.05)
+    assert abs(np.nanmean(mp["L1C"])) < 1e-9 + 0.3 / np.sqrt(400)
+
+
+def test_an_lli_flag_starts_a_new_arc():
+    t, obs = _dual()
+    obs["carrier"]["L1C"][200:, 0] += 17.0                 # a slip of 17 cycles, flagged
+    obs["lli"]["L1C"][200, 0] = 1
+    mp = fidelity.multipath(obs, ["L1C", "L2W"], [L1.freq_hz, L2.freq_hz], t)
+    assert np.nanstd(mp["L1C"][:, 0]) < 0.35
+    assert fidelity.slips_per_hour(obs, ["L1C"], t)["L1C"] == pytest.approx(1 / (3 * 400 / 3600.0))
+
+
+def test_carrier_noise_of_white_phase_from_third_differences():
+    t, obs = _dual(sigma_phase=0.003)
+    cn = fidelity.carrier_noise(obs, ["L1C", "L2W"], [L1.freq_hz, L2.freq_hz], t)
+    assert fidelity.robust_std(cn["L1C+L2W"]) == pytest.approx(0.003 * np.sqrt(2), rel=0.08)
+
+
+def test_doppler_residual_is_the_doppler_noise():
+    t, obs = _dual()
+    res = fidelity.doppler_residual(obs, ["L1C"], [L1.freq_hz], t)["L1C"]
+    phase_rate_noise = 0.002 / L1.wavelength_m / np.sqrt(2)   # (e_k+1 - e_k-1) / 2 dt
+    assert fidelity.robust_std(res) == pytest.approx(np.hypot(0.05, phase_rate_noise), rel=0.08)
+
+
+def test_pairs_take_the_most_distant_frequency():
+    names = ["L1C", "L2W", "L5Q", "B1I", "B3I", "B1C", "B2a"]
+    sig = [sigmod.get(n) for n in names]
+    p = fidelity.pairs(names, [g.system for g in sig], [g.freq_hz for g in sig])
+    assert p["L1C"] == "L5Q" and p["B1C"] == "B2a" and p["B1I"] == "B2a" and p["B3I"] == "B1C"
+
+
+def test_cn0_fit_recovers_the_simulator_model():
+    rng = np.random.default_rng(3)
+    m, s = 50, 8
+    el = np.radians(rng.uniform(5, 85, (m, s)))
+    real = {"t": np.arange(m) * 30.0, "signals": ["L1C"], "freq": [L1.freq_hz], "obs": {k: {} for k in twin.KINDS}}
+    cn0 = 42.0 + L1.cn0_offset_db - 14.0 * ((np.pi / 2 - el) / (np.pi / 2)) ** 2 + 0.3 * rng.standard_normal((m, s))
+    t, obs = _dual(m=m, s=s)
+    real["obs"] = {k: {"L1C": obs[k]["L1C"]} for k in twin.KINDS}
+    real["obs"]["cn0"]["L1C"] = cn0
+    # satellites placed so that the geometry gives exactly these elevations: straight up along the local vertical
+    ref = np.array([6378137.0, 0.0, 0.0])
+    east = np.array([0.0, 1.0, 0.0])
+    up = np.array([1.0, 0.0, 0.0])
+    dist = 2.0e7
+    real["sat_pos"] = ref + dist * (np.cos(el)[..., None] * east + np.sin(el)[..., None] * up)
+    p = twin.fit_parameters(real, ref)
+    assert p["cn0_zenith_dbhz"] == pytest.approx(42.0, abs=0.2) and p["rolloff_db"] == pytest.approx(14.0, abs=0.4)
+
+
+@pytest.mark.slow
+def test_twin_of_kms3_with_fit(tmp_path, capsys):
+    out = tmp_path / "twin"
+    assert main(["twin", str(KMS3_OBS), "--nav", str(KMS3_NAV), "-o", str(out), "--fit"]) == 0
+    report = capsys.readouterr().out
+    assert "visibility agreement" in report and (out / "report.md").read_text() == report
+    fid = json.loads((out / "fidelity.json").read_text())
+    for k in ("default", "fitted"):
+        c = fid[k]
+        assert c["visibility_agreement"] > 0.95 and c["tracked_real_not_twin"] == 0
+        assert c["disagreement_max_elevation_deg"] < 2.0          # only rising and setting satellites differ
+    ratios = {k: [x for v in fid[k]["code_noise_ratio"].values() for x in v if x] for k in ("default", "fitted")}
+    assert np.median(ratios["default"]) > 2.0                      # simkit's defaults: a noisier receiver
+    assert 0.8 < np.median(ratios["fitted"]) < 1.25                 # the calibrated twin
+    assert np.mean([abs(x - 1) <= 0.5 for x in ratios["fitted"]]) > 0.8
+    fragment = tomllib.loads((out / "fitted.toml").read_text())
+    assert set(fragment["gnss"]["code_error_scale"]) == set(fid["signals"])
+    for name in ("tracked.png", "code_noise.png", "twin.h5", "twin_fit.h5", "real.h5"):
+        assert (out / name).is_file()
+
+
+def test_twin_needs_a_reference_and_navigation(tmp_path, capsys):
+    from realdata_helpers import BERLIN_NAV, BERLIN_OBS
+
+    assert main(["twin", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "-o", str(tmp_path / "t"), "--no-plots"]) == 2
+    assert "no reference position" in capsys.readouterr().err
+
+
+def test_the_fitted_fragment_is_a_valid_gnss_section(tmp_path):
+    """The fragment merged into the twin's scenario loads (every key known, every value in range)."""
+    from simkit.scenario import load
+
+    p = dict(twin.DEFAULTS, code_error_scale={"L1C": 0.2})
+    fragment = tomllib.loads(twin.toml_fragment(p))
+    real = {"t": np.arange(20) * 30.0, "signals": ["L1C"], "start": (2213, 295200.0)}
+    sc = twin.scenario(real, np.array([3516213.438, 781859.8595, 5246037.966]), [str(KMS3_NAV)], 5.0, {}, 1)
+    sc["gnss"].update({k: v for k, v in fragment["gnss"].items() if k != "antenna"})
+    sc["gnss"]["antenna"] = fragment["gnss"]["antenna"]
+    loaded = load(sc)
+    assert loaded.gnss.code_error_scale == {"L1C": 0.2}
+    assert loaded.gnss.multipath.carrier_sigma_m == pytest.approx(0.01)
