@@ -70,7 +70,7 @@ def ionosphere_free(g):
     L1/L2 T_GD, whose clock is the L1/L2 combination's); NaN where a satellite has one frequency at an epoch.
     Returns (code, group delay, None, description)."""
     m, s = next(iter(g.obs["code"].values())).shape
-    systems = _system_of(g.sat_id)
+    systems = systems_of(g.sat_id)
     freq = 299792458.0 / np.asarray(g.wavelength_m, float)
     code, gd = np.full((m, s), np.nan), np.zeros(s)
     pairs = []
