@@ -186,7 +186,7 @@ def _bad_cases():
         "few": ("a.nmea", _nmea(t[:3] * 6, lat[:3], lon[:3], h[:3]), "need at least 4"),
         "gap": ("a.nmea", _nmea(np.r_[t[:4], t[4:] + 11.0], lat, lon, h), "longer than trajectory.max_gap_s"),
         "short": ("a.nmea", _nmea(t[:8], lat[:8], lon[:8], h[:8]), "does not cover scenario.start"),
-        "standing": ("a.nmea", _nmea(t, np.full_like(lat, lat[0]), lon, h), "slows to"),
+        "standing": ("a.nmea", _nmea(t, np.full_like(lat, lat[0]), lon, h), "never moves at"),
         "gpx time": ("a.gpx", GPX.replace("<time>2026-04-27T06:00:00Z</time>", ""), "track point 1"),
         "gpx xml": ("a.gpx", GPX[:-30], "not well-formed XML"),
         "kml line": ("a.kml", '<kml xmlns="http://www.opengis.net/kml/2.2"><Placemark><LineString><coordinates>'

@@ -97,11 +97,12 @@ def _parse_logged(sec: Section, rate: float) -> TrajectoryConfig:
     att_sigma = sec.get("attitude_sigma_deg", float, None, check=positive)
     gap = sec.get("max_gap_s", float, 10.0, check=positive)
     vmax = sec.get("max_speed_m_per_s", float, 500.0, check=positive)
+    outliers = sec.get("outliers", str, "refuse", choices=("refuse", "drop"))
     sec.done()
     fit = FitOptions(position_sigma_m=None if sigma is None else tuple(np.broadcast_to(np.asarray(sigma, float), 3)),
                      velocity_sigma_m_per_s=sigma_v, attitude=attitude,
                      attitude_sigma_rad=None if att_sigma is None else float(np.radians(att_sigma)),
-                     max_gap_s=gap, max_speed_m_per_s=vmax)
+                     max_gap_s=gap, max_speed_m_per_s=vmax, outliers=outliers)
     nan = float("nan")
     return TrajectoryConfig(rate_hz=rate, lat_rad=nan, lon_rad=nan, height_m=nan, speed_m_per_s=nan,
                             flight_path_rad=nan, heading_rad=nan, roll_rad=0.0, coordinated_turns=False,

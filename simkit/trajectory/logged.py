@@ -34,6 +34,8 @@ from .truth import TrajectoryTruth, body_rate_nb
 ATTITUDE_RULES = ("log", "ground", "coordinated")
 MIN_POINTS = 4
 MIN_SPEED_M_PER_S = 1.0            # the velocity-following rules need a direction of motion
+HELD_SIGMA_RAD = 1e-3              # ground rule through stops: the angles are fitted to ~0.06 deg at >= 5 m/s
+HELD_SPEED_M_PER_S = 5.0           # below it a heading sample's sigma grows as 1 / speed (noise turns it more)
 _SIGMA_FLOOR_M = 1e-3              # an exact (noise-free) log still gets finite weights
 _SIGMA_FLOOR_RAD = 1e-6
 
@@ -70,6 +72,7 @@ class FitOptions:
     attitude_sigma_rad: float | None = None
     max_gap_s: float = 10.0
     max_speed_m_per_s: float = 500.0
+    outliers: str = "refuse"                   # "refuse": a jump is an error; "drop": its outlying samples go
 
 
 def check(track: Track, opts: FitOptions) -> None:
@@ -94,13 +97,41 @@ def check(track: Track, opts: FitOptions) -> None:
                                  f"select a part of the log with scenario.start / duration_s", int(track.line[k + 1]))
 
 
-def check_jumps(track: Track, opts: FitOptions, sigma_m: float) -> None:
-    """Refuse a step between samples faster than ``max_speed_m_per_s`` plus 6 sigma of noise (``sigma_m``)."""
+def _jumps(track: Track, opts: FitOptions, sigma_m) -> np.ndarray:
+    """Indices k of the steps k -> k + 1 faster than ``max_speed_m_per_s`` plus 6 sigma of noise on some local
+    axis (E, N, U at the first sample; ``sigma_m`` a scalar or per axis (3,) m)."""
+    lla = frames.ecef_to_lla(track.pos_ecef[0])
+    step = np.abs(np.diff(track.pos_ecef, axis=0) @ frames.ecef_to_enu_matrix(lla[0], lla[1]).T)
+    allowed = opts.max_speed_m_per_s * np.diff(track.t)[:, None] + 6.0 * np.sqrt(2.0) * np.asarray(sigma_m, float)
+    return np.flatnonzero((step > allowed).any(axis=1))
+
+
+def drop_jumps(track: Track, opts: FitOptions, sigma_m) -> tuple[Track, np.ndarray]:
+    """The track without its outlying samples, and their lines: while a step is too fast, of its two ends the one
+    farther from the median position of its 8 neighbours (4 either side, itself excluded) is dropped."""
+    dropped = []
+    while True:
+        bad = _jumps(track, opts, sigma_m)
+        if bad.size == 0:
+            return track, np.asarray(dropped, dtype=np.int64)
+        k = int(bad[0])
+        dev = []
+        for j in (k, k + 1):
+            near = np.r_[max(0, j - 4):j, j + 1:min(len(track.t), j + 5)]
+            dev.append(np.linalg.norm(track.pos_ecef[j] - np.median(track.pos_ecef[near], axis=0)))
+        j = k if dev[0] > dev[1] else k + 1
+        dropped.append(int(track.line[j]))
+        track = track.take(np.r_[0:j, j + 1:len(track.t)])
+
+
+def check_jumps(track: Track, opts: FitOptions, sigma_m) -> None:
+    """Refuse a step between samples faster than ``max_speed_m_per_s`` plus 6 sigma of noise (``sigma_m`` (3,)
+    m per local axis) on some axis."""
     src, dt = track.source, np.diff(track.t)
     step = np.linalg.norm(np.diff(track.pos_ecef, axis=0), axis=1)
-    allowed = opts.max_speed_m_per_s * dt + 6.0 * np.sqrt(2.0) * sigma_m
-    if np.any(step > allowed):
-        k = int(np.nonzero(step > allowed)[0][0])
+    bad = _jumps(track, opts, sigma_m)
+    if bad.size:
+        k = int(bad[0])
         raise DataFileError(src, f"jump of {step[k]:.1f} m in {dt[k]:.3g} s ({step[k] / dt[k]:.0f} m/s) from line "
                                  f"{track.line[k]}, above trajectory.max_speed_m_per_s = {opts.max_speed_m_per_s:g} "
                                  f"(plus 6 sigma of noise)", int(track.line[k + 1]))
@@ -137,7 +168,14 @@ class LoggedPath:
         local = (track.pos_ecef - self.r0) @ self.c_le
         sig, self.sigma_source = _sigmas(track, local, opts)
         self.sigma_m = np.sqrt(np.mean(sig**2, axis=0))
-        check_jumps(track, opts, float(np.max(self.sigma_m)))
+        self.dropped = np.zeros(0, dtype=np.int64)
+        if opts.outliers == "drop":
+            t_all = track.t
+            track, self.dropped = drop_jumps(track, opts, self.sigma_m)
+            kept = np.searchsorted(t_all, track.t)
+            local, sig = local[kept], sig[kept]
+            check(track, opts)
+        check_jumps(track, opts, self.sigma_m)
         t = track.t
         if t[0] > 1e-9 or t[-1] < duration_s - 1e-9:
             raise DataFileError(track.source, f"the log covers {t[0]:.3f} s to {t[-1]:.3f} s from scenario.start, "
@@ -150,7 +188,11 @@ class LoggedPath:
         if self.rule == "log":
             self._fit_attitude(track, opts)
         else:
-            self._check_motion(np.linspace(0.0, duration_s, max(2, int(np.ceil(duration_s / min(spacing, 0.1))) + 1)))
+            grid = np.linspace(0.0, duration_s, max(2, int(np.ceil(duration_s / min(spacing, 0.1))) + 1))
+            if self.rule == "ground" and self._slowest(grid)[0] < MIN_SPEED_M_PER_S:
+                self._hold_through_stops(track.t, opts)
+            else:
+                self._check_motion(grid)
 
     def _local_velocity(self, track: Track, opts: FitOptions):
         """Logged velocities in L and their sigmas (K, 3), or (None, None) when absent or of unknown accuracy."""
@@ -186,12 +228,35 @@ class LoggedPath:
             sa = max(sa if np.isfinite(sa) else 0.0, _SIGMA_FLOOR_RAD)
             self.att_splines.append(pspline.smooth(self.knots, track.t, angles[:, i], np.full(len(track.t), sa))[0])
 
-    def _check_motion(self, grid):
-        """The velocity-following rules need a direction of motion throughout the run."""
+    def _slowest(self, grid):
+        """(the lowest horizontal speed of the fitted path on ``grid`` (m/s), its index)."""
         v = np.stack([s(grid, 1) for s in self.splines], -1)
         vh = np.hypot(v[:, 0], v[:, 1])          # the tangent plane's horizontal, to within the log's extent
-        if vh.min() < MIN_SPEED_M_PER_S:
-            k = int(np.argmin(vh))
+        return float(vh.min()), int(np.argmin(vh))
+
+    def _hold_through_stops(self, t, opts):
+        """Ground rule with stops: the heading and pitch of the fitted velocity at the log's epochs where it moves
+        at half HELD_SPEED_M_PER_S or more (slower, the fit's lateral wander of a few cm turns it by degrees), carried (linearly in heading) through the slower epochs, then fitted by the
+        same smoothing spline as logged angles (sigma ``HELD_SIGMA_RAD``, growing as 1 / speed below
+        ``HELD_SPEED_M_PER_S``), so the attitude and its rates stay smooth and exact through a stop; roll zero."""
+        v = np.stack([s(t, 1) for s in self.splines], -1)
+        vh = np.hypot(v[:, 0], v[:, 1])
+        moving = vh >= 0.5 * HELD_SPEED_M_PER_S
+        if moving.sum() < 2:
+            raise DataFileError(self.source, f"the fitted path never moves at {0.5 * HELD_SPEED_M_PER_S:g} m/s or "
+                                             f"more on two epochs: attitude rule 'ground' has no direction to hold")
+        heading = np.unwrap(np.arctan2(v[moving, 0], v[moving, 1]))
+        pitch = np.arctan2(v[moving, 2], vh[moving])
+        angles = np.stack([np.interp(t, t[moving], pitch), np.zeros_like(t), np.interp(t, t[moving], heading)], -1)
+        sigma = HELD_SIGMA_RAD * np.where(moving, np.maximum(1.0, HELD_SPEED_M_PER_S / np.maximum(vh, 1e-9)), 1.0)
+        self.att_splines = [pspline.smooth(self.knots, t, angles[:, i], sigma)[0] for i in range(3)]
+        self.held_epochs = int((~moving).sum())
+
+    def _check_motion(self, grid):
+        """The velocity-following rules need a direction of motion throughout the run."""
+        vmin, k = self._slowest(grid)
+        if vmin < MIN_SPEED_M_PER_S:
+            vh = np.full(len(grid), vmin)
             raise DataFileError(self.source, f"the fitted path slows to {vh[k]:.2f} m/s at {grid[k]:.1f} s: "
                                              f"attitude rule {self.rule!r} needs a horizontal speed of at least "
                                              f"{MIN_SPEED_M_PER_S:g} m/s (give attitude in the log, or select a "
@@ -201,7 +266,8 @@ class LoggedPath:
         """What the fit used and found (the ``log`` attribute of /truth): rule, sigmas and their source, residual
         RMS per axis (m), plus whatever the reader added to ``provenance`` (file, digest)."""
         return dict(getattr(self, "provenance", {}), attitude=self.rule, sigma_m=self.sigma_m.tolist(),
-                    sigma_source=self.sigma_source, residual_rms_m=self.residual_rms_m.tolist())
+                    sigma_source=self.sigma_source, residual_rms_m=self.residual_rms_m.tolist(),
+                    dropped_lines=self.dropped.tolist(), held_epochs=getattr(self, "held_epochs", 0))
 
     def truth(self, t) -> TrajectoryTruth:
         """Truth at times ``t`` (N,) s since the scenario start."""
@@ -215,7 +281,7 @@ class LoggedPath:
         v_n = np.einsum("nij,nj->ni", c_en, v_e)
         w_en = earth.transport_rate_enu(lat, hgt, v_n)
         a_n = np.einsum("nij,nj->ni", c_en, a_e) - np.cross(w_en, v_n)
-        if self.rule == "log":
+        if self.att_splines is not None:
             (gamma, roll, psi), (gamma_dot, roll_dot, psi_dot) = (
                 [np.stack([s(t, nu) for s in self.att_splines]) for nu in (0, 1)])
         else:
