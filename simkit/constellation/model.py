@@ -277,3 +277,51 @@ class KeplerConstellation(Constellation):
     def _evaluate(self, t, velocity):
         idx, t_eval = self.select(t)
         return kepler.propagate(self.records.params, idx.ravel(), t_eval.ravel(), velocity)
+
+
+class CombinedConstellation(Constellation):
+    """Several constellations read from one source (a mixed navigation file: Keplerian systems and GLONASS),
+    seen as one: ``sat_ids`` are the parts' in order, and all parts count seconds from the same ``ref_week``.
+    ``records`` is the first (Keplerian) part's record table, whose satellite indices are valid in ``sat_ids``
+    because that part comes first."""
+
+    def __init__(self, parts: list[Constellation], source: str):
+        if len({p.ref_week for p in parts}) != 1:
+            raise ValueError("combined constellations must share their reference week")
+        klob = {k: v for p in reversed(parts) for k, v in p.klobuchar.items()}
+        super().__init__([s for p in parts for s in p.sat_ids], np.concatenate([p.orbit_type for p in parts]),
+                         source, parts[0].ref_week, klob)
+        self.parts = list(parts)
+        self.kind = parts[0].kind
+        self._bounds = np.cumsum([0] + [len(p.sat_ids) for p in parts])
+
+    def part(self, system: str):
+        """The part holding satellites of ``system`` ('R' -> the GLONASS part), or None."""
+        return next((p for p in self.parts if system in set(p.system)), None)
+
+    @property
+    def records(self):
+        return self.parts[0].records
+
+    def _intervals(self):
+        spans = [p._intervals() for p in self.parts]
+        return (np.concatenate([s[0] for s in spans]), np.concatenate([s[1] for s in spans]),
+                min(s[2] for s in spans))
+
+    def _evaluate(self, t, velocity):
+        n = t.shape[0]
+        outs = []
+        for p, a, b in zip(self.parts, self._bounds[:-1], self._bounds[1:]):
+            res = p._evaluate(np.ascontiguousarray(t[:, a:b]), velocity)
+            outs.append([r.reshape((n, b - a) + r.shape[1:]) for r in res])
+        return tuple(np.concatenate(cols, axis=1).reshape((-1,) + cols[0].shape[2:]) for cols in zip(*outs))
+
+    def group_delay_names(self) -> list[str]:
+        return sorted({n for p in self.parts for n in p.group_delay_names()})
+
+    def group_delays(self, gps_week=None, gps_sow=None) -> dict[str, np.ndarray]:
+        out: dict[str, np.ndarray] = {}
+        for p, a, b in zip(self.parts, self._bounds[:-1], self._bounds[1:]):
+            for name, vals in p.group_delays(gps_week, gps_sow).items():
+                out.setdefault(name, np.full(len(self.sat_ids), np.nan))[a:b] = vals
+        return out

@@ -29,7 +29,7 @@ def resolve(source) -> Path:
                         f"(bundled: {', '.join(bundled_files()) or 'none'}; or nominal:gps / nominal:bds)")
 
 
-def load(source, *, validity_days: float | None = None) -> Constellation:
+def load(source, *, validity_days: float | None = None, systems: str | None = None) -> Constellation:
     """Load a constellation.
 
     ``source``: ``nominal:gps``, ``nominal:bds`` (= ``nominal:bds3``), ``nominal:bds2``, ``nominal:bds3``,
@@ -37,7 +37,9 @@ def load(source, *, validity_days: float | None = None) -> Constellation:
     from the broadcast records nearest the middle of the file, see :func:`almanac.from_ephemeris`). Files: RINEX 3.0x/4.00 navigation (plain or .gz),
     YUMA or SEM GPS almanacs, TLE sets (2- or 3-line). ``validity_days`` (almanac and TLE sources only) is the
     span either side of the almanac/TLE epoch in which states are returned (default 7 days); broadcast
-    ephemerides always use their fit interval (GPS +-2 h, BDS +-1 h).
+    ephemerides always use their fit interval (GPS, Galileo, QZSS +-2 h, BDS +-1 h, GLONASS +-30 min).
+    ``systems`` (RINEX navigation files only): the system letters to keep, e.g. ``"GC"`` (default: all of
+    G, C, E, J, R in the file).
     """
     text = str(source)
     if text.startswith("almanac:"):
@@ -59,7 +61,7 @@ def load(source, *, validity_days: float | None = None) -> Constellation:
 
     raw = read_bytes(path)
     if rinex_nav.is_rinex_nav(lines_of(raw[:200])):
-        return rinex_nav.read(path, raw)
+        return rinex_nav.read(path, raw, systems)
     lines = lines_of(raw)
     kw = {} if validity_days is None else {"validity_days": validity_days}
     if almanac.is_yuma(lines):
