@@ -129,7 +129,7 @@ class GlonassConstellation(Constellation):
         super().__init__(sat_ids, ["MEO"] * len(sat_ids), source, ref_week)
         self.records = records
         tb = records.params[:, TB]
-        self.channel = np.zeros(len(sat_ids), dtype=np.int64)
+        self.channel = np.zeros(len(sat_ids), dtype=np.int64)  # (S,) FDMA frequency numbers
         self._sel = []
         for s in range(len(sat_ids)):
             mine = records.sat == s
@@ -138,6 +138,10 @@ class GlonassConstellation(Constellation):
                     + min(FREQ_CHANNELS)
             rows = np.flatnonzero(mine & records.healthy)
             self._sel.append(rows[np.argsort(tb[rows], kind="stable")])
+
+    @property
+    def channels(self) -> np.ndarray:
+        return self.channel
 
     def select(self, t: np.ndarray) -> np.ndarray:
         """Record index (N, S) for times ``t`` (N, S): the healthy record with the nearest tb (the later on a

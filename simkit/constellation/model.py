@@ -83,6 +83,11 @@ class Constellation:
     def __len__(self) -> int:
         return len(self.sat_ids)
 
+    @property
+    def channels(self) -> np.ndarray:
+        """(S,) int: GLONASS FDMA frequency numbers k (0 for CDMA satellites)."""
+        return np.zeros(len(self.sat_ids), dtype=np.int64)
+
     def __repr__(self) -> str:
         kinds = {s: int(np.sum(self.system == s)) for s in np.unique(self.system)}
         return f"<{type(self).__name__} {self.kind} {kinds} from {self.source}>"
@@ -294,6 +299,10 @@ class CombinedConstellation(Constellation):
         self.parts = list(parts)
         self.kind = parts[0].kind
         self._bounds = np.cumsum([0] + [len(p.sat_ids) for p in parts])
+
+    @property
+    def channels(self) -> np.ndarray:
+        return np.concatenate([p.channels for p in self.parts])
 
     def part(self, system: str):
         """The part holding satellites of ``system`` ('R' -> the GLONASS part), or None."""
