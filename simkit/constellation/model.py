@@ -216,13 +216,17 @@ def describe_span(span) -> str:
 class Records:
     """Keplerian records: ``params`` (R, len(kepler.FIELDS)), ``sat`` (R,) index, ``healthy`` (R,) bool,
     ``half_width`` (R,) s validity either side of toe (np.inf: always valid), ``period`` (R,) s or None: a
-    record repeats with this period (10-bit almanac weeks: 1024 weeks) and each query uses its nearest copy."""
+    record repeats with this period (10-bit almanac weeks: 1024 weeks) and each query uses its nearest copy.
+    ``after_toe`` (R,) bool or None: the record is valid only after its toe, for ``half_width`` s, and the latest
+    such record is used instead of the nearest (Galileo: a navigation batch is broadcast after its toe and holds
+    for 4 h; RTKLIB's ``seleph`` takes the latest I/NAV record with toe before t the same way)."""
 
     params: np.ndarray
     sat: np.ndarray
     healthy: np.ndarray
     half_width: np.ndarray
     period: np.ndarray | None = None
+    after_toe: np.ndarray | None = None
 
 
 class KeplerConstellation(Constellation):
@@ -243,6 +247,7 @@ class KeplerConstellation(Constellation):
         self.records = records
         toe = p[:, kepler.COL["toe"]]
         period = records.period if records.period is not None else np.full(len(toe), np.inf)
+        after = records.after_toe if records.after_toe is not None else np.zeros(len(toe), bool)
         self._sel = []
         for s in range(len(sat_ids)):
             rows = np.flatnonzero((records.sat == s) & records.healthy)
@@ -250,7 +255,8 @@ class KeplerConstellation(Constellation):
             per = np.unique(period[rows])
             if per.size > 1:
                 raise ValueError(f"{sat_ids[s]}: records with different repeat periods")
-            self._sel.append((rows, toe[rows], records.half_width[rows], per[0] if per.size else np.inf))
+            self._sel.append((rows, toe[rows], records.half_width[rows], per[0] if per.size else np.inf,
+                              bool(after[rows].all()) if rows.size else False))
 
     def select(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Record index (N, S) for times ``t`` (N, S) (GPS s since ``ref_week``, column s for satellite s): the
@@ -258,12 +264,18 @@ class KeplerConstellation(Constellation):
         Also returns the times to evaluate at (``t`` moved by whole periods for repeating almanac records)."""
         idx = np.full(t.shape, -1, dtype=np.int64)
         t_eval = np.array(t, dtype=float)
-        for s, (rows, toe, half, period) in enumerate(self._sel):
+        for s, (rows, toe, half, period, after) in enumerate(self._sel):
             if rows.size == 0:
                 continue
             ts = t_eval[:, s]  # a view: shifting it shifts t_eval
             if np.isfinite(period):
                 ts -= period * np.round((ts - toe[0]) / period)
+            if after:  # the latest toe strictly before t, up to half_width after it
+                j = np.searchsorted(toe, ts, side="left") - 1
+                pick = np.maximum(j, 0)
+                ok = (j >= 0) & (ts - toe[pick] <= half[pick])
+                idx[:, s] = np.where(ok, rows[pick], -1)
+                continue
             j = np.searchsorted(toe, ts, side="right")  # toe[j-1] <= t < toe[j]
             lo = np.clip(j - 1, 0, rows.size - 1)
             hi = np.clip(j, 0, rows.size - 1)
@@ -276,8 +288,9 @@ class KeplerConstellation(Constellation):
         r = self.records
         toe = r.params[r.healthy, kepler.COL["toe"]]
         half = r.half_width[r.healthy]
+        after = r.after_toe[r.healthy] if r.after_toe is not None else np.zeros(toe.size, bool)
         period = np.unique(r.period[r.healthy]) if r.period is not None else np.array([np.inf])
-        return toe - half, toe + half, float(period.min()) if period.size else np.inf
+        return np.where(after, toe, toe - half), toe + half, float(period.min()) if period.size else np.inf
 
     def _evaluate(self, t, velocity):
         idx, t_eval = self.select(t)

@@ -376,7 +376,7 @@ def build(ids, vals, source, klob, cnav_delays, path, fnav=None) -> KeplerConste
         has_inav = np.zeros(len(sat_ids), bool)
         has_inav[sat[~fnav & (letter == "E")]] = True
         use &= ~(fnav & has_inav[sat])
-    records = Records(p, sat, use, half)
+    records = Records(p, sat, use, half, after_toe=letter == "E")
     delays = {}
     is_gal = letter == "E"
     for name, f, m in (("TGD", TGD1, (letter == "G") | (letter == "J")), ("TGD1", TGD1, is_bds),
