@@ -22,7 +22,7 @@ import numpy as np
 from ..constellation.geometry import angles_from_enu
 from ..earth import C_LIGHT, OMEGA_E
 from ..frames import ecef_to_enu_matrix, ecef_to_lla
-from ..gnss.atmosphere import broadcast_ionosphere, reference_frequency, troposphere
+from ..gnss.atmosphere import broadcast_ionosphere, model_system, reference_frequency, troposphere
 from .errors import EstimatorInputError
 
 
@@ -100,7 +100,9 @@ def _position(code, sat, sys_onehot, mask_rad, sigma, iterations, delays):
     x = np.zeros((m, 3 + sys_onehot.shape[1]))
     used = np.isfinite(code)
     for it in range(iterations):
-        rho, e = _geometry(x[:, :3], sat)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rho, e = _geometry(x[:, :3], sat)
+        e = np.nan_to_num(e)  # a satellite without a state (unhealthy) sits at the origin, as the receiver at first
         el, az, lla = _elevation(x[:, :3], e)
         late = it >= 3  # the atmosphere, mask and weights once the position is near (from the Earth's centre)
         atm = delays(lla, el, az) if late else 0.0
@@ -126,8 +128,9 @@ def _delays(systems, wavelength_m, iono_coefficients, gps_sow, m) -> _Delays:
     if any(a.shape != (4,) or b.shape != (4,) for a, b in coef.values()):
         raise EstimatorInputError("spp: iono_coefficients: expected {system: (alpha (4,), beta (4,))}")
     freq = C_LIGHT / np.asarray(wavelength_m, float)
-    ref = np.array([reference_frequency(k) if k in coef else np.nan for k in systems])
-    return _Delays(coef, np.nan_to_num((ref / freq) ** 2), np.asarray(gps_sow, float), systems)
+    model = np.array([model_system(k) for k in systems])  # Galileo, QZSS, GLONASS: the GPS model from L1
+    ref = np.array([reference_frequency(k) if k in coef else np.nan for k in model])
+    return _Delays(coef, np.nan_to_num((ref / freq) ** 2), np.asarray(gps_sow, float), model)
 
 
 def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, group_delay_m=None,
