@@ -202,51 +202,8 @@ def read(path, raw: bytes | None = None, systems: str | None = None):
     head_end = raw.find(b"END OF HEADER")
     head_end = len(raw) if head_end < 0 else raw.find(b"\n", head_end) + 1 or len(raw)
     start, version, klob = _header(lines_of(raw[:head_end]) + [""], path)
-    ids, vals, delays, fnav, glo = [], [], [], [], []
-    if version < 4.0:
-        buf = np.frombuffer(raw, np.uint8)
-        nl = np.flatnonzero(buf == 10)
-        n_lines = nl.size + (1 if buf.size and buf[-1] != 10 else 0)
-        rec, values, glo_rec = _rinex3_records(buf, nl, start, n_lines, path, systems)
-        line_start = np.concatenate(([0], nl + 1))
-        heads = [raw[a:a + 23].decode("latin-1") for a in line_start[rec]]
-        ids = [_sat_id(h[:3]) for h in heads]
-        toc = np.array([_epoch_seconds(h[4:23], path, i + 1) for h, i in zip(heads, rec)])
-        vals = np.column_stack([values, toc]) if rec.size else []
-        fnav = [id_[0] == "E" and int(v[CODES]) & 2 != 0 for id_, v in zip(ids, values)]
-        if glo_rec.size:
-            text = lines_of(raw)
-            glo = [_glonass_record(text[i:i + 4], path, i + 1) for i in glo_rec]
-    else:
-        lines = lines_of(raw)
-        for ln, head, block in _rinex4_blocks(lines, start, path):
-            parts = head[1:].split()
-            if len(parts) < 3:
-                raise DataFileError(path, "record header should read '> TYPE SAT MESSAGE'", ln)
-            rtype, sat, msg = parts[0], parts[1], parts[2]
-            if sat[0] not in systems:
-                continue
-            if rtype == "ION" and sat[0] not in klob and (msg, sat[0]) in (("LNAV", "G"), ("D1D2", "C")):
-                klob[sat[0]] = _ion4(block, path, ln + 1)
-            elif rtype == "EPH" and (sat[0], msg) in _KEPLER_MESSAGES:
-                _check_len(block, ln + 1, path)
-                ids.append(_sat_id(block[0][:3]))
-                fnav.append(msg == "FNAV")
-                vals.append(np.append(_values(block, path, ln + 1),
-                                      _epoch_seconds(block[0][4:23], path, ln + 1)))
-            elif rtype == "EPH" and sat[0] == "R" and msg == "FDMA":
-                if len(block) < 4:
-                    raise DataFileError(path, f"FDMA record for {sat} has {len(block)} lines, expected 5",
-                                        ln + len(block))
-                glo.append(_glonass_record(block[:4], path, ln + 1))
-            elif rtype == "EPH" and msg in _CNV_DELAYS and sat[0] == "C":
-                if len(block) < 8:
-                    raise DataFileError(path, f"{msg} record is truncated", ln + len(block))
-                row = [number(block[7][4 + 19 * k: 23 + 19 * k], path, ln + 8, "group delay", blank=np.nan)
-                       for k in range(4)]
-                t = _epoch_seconds(block[0][4:23], path, ln + 1)
-                delays.extend((name, _sat_id(block[0][:3]), t, row[f - 24])
-                              for f, name in _CNV_DELAYS[msg].items())
+    body = _rinex3_body if version < 4.0 else _rinex4_body
+    ids, vals, delays, fnav, glo = body(raw, start, path, systems, klob)
     if not ids and not glo:
         wanted = ", ".join(SYSTEM_NAMES[c] for c in systems)
         raise DataFileError(path, f"no broadcast ephemeris records found for {wanted or 'any system'}")
@@ -263,6 +220,58 @@ def read(path, raw: bytes | None = None, systems: str | None = None):
     if not ids:
         return glo_c
     return CombinedConstellation([kep, glo_c], str(path))
+
+
+def _rinex3_body(raw, start, path, systems, klob):
+    """RINEX 3 records -> (ids, values + toc rows, CNAV delays (none), F/NAV flags, GLONASS records)."""
+    buf = np.frombuffer(raw, np.uint8)
+    nl = np.flatnonzero(buf == 10)
+    n_lines = nl.size + (1 if buf.size and buf[-1] != 10 else 0)
+    rec, values, glo_rec = _rinex3_records(buf, nl, start, n_lines, path, systems)
+    line_start = np.concatenate(([0], nl + 1))
+    heads = [raw[a:a + 23].decode("latin-1") for a in line_start[rec]]
+    ids = [_sat_id(h[:3]) for h in heads]
+    toc = np.array([_epoch_seconds(h[4:23], path, i + 1) for h, i in zip(heads, rec)])
+    vals = np.column_stack([values, toc]) if rec.size else []
+    fnav = [id_[0] == "E" and int(v[CODES]) & 2 != 0 for id_, v in zip(ids, values)]
+    glo = []
+    if glo_rec.size:
+        text = lines_of(raw)
+        glo = [_glonass_record(text[i:i + 4], path, i + 1) for i in glo_rec]
+    return ids, vals, [], fnav, glo
+
+
+def _rinex4_body(raw, start, path, systems, klob):
+    """RINEX 4 records -> (ids, values + toc rows, BDS CNAV group delays, F/NAV flags, GLONASS records); the
+    first ION record of GPS LNAV / BDS D1D2 fills ``klob``."""
+    ids, vals, delays, fnav, glo = [], [], [], [], []
+    for ln, head, block in _rinex4_blocks(lines_of(raw), start, path):
+        parts = head[1:].split()
+        if len(parts) < 3:
+            raise DataFileError(path, "record header should read '> TYPE SAT MESSAGE'", ln)
+        rtype, sat, msg = parts[0], parts[1], parts[2]
+        if sat[0] not in systems:
+            continue
+        if rtype == "ION" and sat[0] not in klob and (msg, sat[0]) in (("LNAV", "G"), ("D1D2", "C")):
+            klob[sat[0]] = _ion4(block, path, ln + 1)
+        elif rtype == "EPH" and (sat[0], msg) in _KEPLER_MESSAGES:
+            _check_len(block, ln + 1, path)
+            ids.append(_sat_id(block[0][:3]))
+            fnav.append(msg == "FNAV")
+            vals.append(np.append(_values(block, path, ln + 1), _epoch_seconds(block[0][4:23], path, ln + 1)))
+        elif rtype == "EPH" and sat[0] == "R" and msg == "FDMA":
+            if len(block) < 4:
+                raise DataFileError(path, f"FDMA record for {sat} has {len(block)} lines, expected 5",
+                                    ln + len(block))
+            glo.append(_glonass_record(block[:4], path, ln + 1))
+        elif rtype == "EPH" and msg in _CNV_DELAYS and sat[0] == "C":
+            if len(block) < 8:
+                raise DataFileError(path, f"{msg} record is truncated", ln + len(block))
+            row = [number(block[7][4 + 19 * k: 23 + 19 * k], path, ln + 8, "group delay", blank=np.nan)
+                   for k in range(4)]
+            t = _epoch_seconds(block[0][4:23], path, ln + 1)
+            delays.extend((name, _sat_id(block[0][:3]), t, row[f - 24]) for f, name in _CNV_DELAYS[msg].items())
+    return ids, vals, delays, fnav, glo
 
 
 SYSTEM_NAMES = {"G": "GPS", "C": "BDS", "E": "Galileo", "J": "QZSS", "R": "GLONASS"}
