@@ -155,15 +155,16 @@ def test_simkit_spp_on_five_error_free_systems_lands_on_the_antenna(five):
 
 
 def test_gps_bds_output_is_unchanged_by_the_other_systems(tmp_path):
-    """The GPS and BDS arrays of a GPS+BDS scenario are bit-identical when Galileo and GLONASS signals are added
-    (draws keyed by satellite; with gnss.slip_rate_per_h = 0, see docs/systems.md for the one exception)."""
-    base = simkit.run("quickstart", out=tmp_path / "a.h5", overrides=["scenario.duration_s=10"])
-    more = simkit.run("quickstart", out=tmp_path / "b.h5",
-                      overrides=["scenario.duration_s=10", 'gnss.signals=["L1C","B1I","E1C","G1C"]'])
+    """The GPS and BDS arrays of a GPS+BDS scenario are bit-identical when Galileo and GLONASS signals are added,
+    even between theirs, with random cycle slips on: noise, multipath and slip events are drawn per satellite."""
+    over = ["scenario.duration_s=30", "gnss.slip_rate_per_h=300"]
+    base = simkit.run("quickstart", out=tmp_path / "a.h5", overrides=over)
+    more = simkit.run("quickstart", out=tmp_path / "b.h5", overrides=over + ['gnss.signals=["L1C","E1C","B1I","G1C"]'])
     with h5py.File(base) as a, h5py.File(more) as b:
         ia, ib = list(a["gnss/sat_id"][:].astype(str)), list(b["gnss/sat_id"][:].astype(str))
         cols = [ib.index(s) for s in ia]
         assert len(ib) > len(ia) + 40
+        assert (a["gnss/obs/L1C/lli"][:] > 0).sum() > (a["gnss/obs/L1C/lli"][0] > 0).sum()  # slips after the start
         for sig in ("L1C", "B1I"):
             for kind in ("code", "carrier", "doppler", "cn0", "ambiguity", "lli"):
                 np.testing.assert_array_equal(a[f"gnss/obs/{sig}/{kind}"][:], b[f"gnss/obs/{sig}/{kind}"][:][..., cols])

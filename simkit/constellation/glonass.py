@@ -6,8 +6,9 @@ The orbit between records is obtained by integrating the equations of motion of 
 A.3.1.2) in the rotating frame: central term, J2 zonal term, centrifugal and Coriolis terms, plus the broadcast
 acceleration held constant. The integrator is the classical fourth-order Runge-Kutta with a fixed 60 s step
 (the last step shortened to land on the requested time), the same scheme and step as RTKLIB's ``geph2pos``,
-so both follow the same discrete trajectory; a finer step would move the result by up to a few decimetres at
-15 min from tb, which is within the broadcast orbit's own error.
+so both follow the same discrete trajectory. The step is not what limits the orbit: a 1 s step moves the result
+by at most 0.7 mm at 15 min and 1.3 mm at 30 min from tb (BRDM 2026, every 97th record; docs/systems.md), far
+below the broadcast orbit's own error (metres).
 
 Clock (ICD 3.3.3): dT = -tau_n + gamma_n (t - tb), in seconds, without group delays; its rate is gamma_n.
 Times: the record epoch is UTC(SU) (RINEX writes it in UTC, not GLONASST = UTC(SU) + 3 h); it is turned into GPS
