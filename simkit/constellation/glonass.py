@@ -22,12 +22,12 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from ..earth import OMEGA_E  # PZ-90's Earth rotation rate, 7.292115e-5 rad/s, is WGS-84's
 from .model import Constellation
 
 MU = 3.9860044e14        # m^3/s^2, PZ-90 (GLONASS ICD 2008, Table 3.2)
 J2 = 1.0826257e-3        # second zonal harmonic of the geopotential, PZ-90
 RE = 6378136.0           # m, semi-major axis of PZ-90
-OMEGA_E = 7.292115e-5    # rad/s, Earth rotation rate, PZ-90
 STEP_S = 60.0            # Runge-Kutta step, s
 FIT_HALF_S = 1800.0      # record validity either side of tb, s
 FREQ_CHANNELS = range(-7, 14)  # valid FDMA channel numbers k (G1 = 1602 + 0.5625 k MHz)
