@@ -245,6 +245,7 @@ class KeplerConstellation(Constellation):
         super().__init__(sat_ids, otype, source, ref_week, klobuchar, group_delays)
         self.kind = kind
         self.records = records
+        self.channel = np.zeros(len(sat_ids), dtype=np.int64)  # FDMA channels (nominal GLONASS sets them)
         toe = p[:, kepler.COL["toe"]]
         period = records.period if records.period is not None else np.full(len(toe), np.inf)
         after = records.after_toe if records.after_toe is not None else np.zeros(len(toe), bool)
@@ -257,6 +258,10 @@ class KeplerConstellation(Constellation):
                 raise ValueError(f"{sat_ids[s]}: records with different repeat periods")
             self._sel.append((rows, toe[rows], records.half_width[rows], per[0] if per.size else np.inf,
                               bool(after[rows].all()) if rows.size else False))
+
+    @property
+    def channels(self) -> np.ndarray:
+        return self.channel
 
     def select(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Record index (N, S) for times ``t`` (N, S) (GPS s since ``ref_week``, column s for satellite s): the
