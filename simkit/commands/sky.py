@@ -27,7 +27,8 @@ HEIGHT_RANGE_M = (-11000.0, 20.0e6)  # deepest ocean floor .. below the GNSS orb
 def add_parser(sub):
     p = sub.add_parser("sky", help="visible satellites per system, DOPs and a sky plot for a place and time span",
                        description="Load a constellation (file, bundled name or nominal:gps / nominal:bds / "
-                                   "nominal:bds2 / nominal:bds3 / nominal:gps+bds), evaluate it from one place "
+                                   "nominal:bds2 / nominal:bds3 / nominal:gps+bds / nominal:gal / nominal:glo / "
+                                   "nominal:gps+bds+gal+glo), evaluate it from one place "
                                    "and print visible counts and DOPs per step; optionally save a sky plot.")
     p.add_argument("source", nargs="?", default=None,
                    help="constellation source (default: the bundled 2026 BRDM broadcast file)")

@@ -33,7 +33,8 @@ def load(source, *, validity_days: float | None = None, systems: str | None = No
     """Load a constellation.
 
     ``source``: ``nominal:gps``, ``nominal:bds`` (= ``nominal:bds3``), ``nominal:bds2``, ``nominal:bds3``,
-    ``nominal:gps+bds``; a file path; a bundled file name; or ``almanac:<RINEX nav source>`` (an almanac derived
+    ``nominal:gps+bds``, ``nominal:gal``, ``nominal:glo``, ``nominal:gps+bds+gal+glo``; a file path; a bundled
+    file name; or ``almanac:<RINEX nav source>`` (an almanac derived
     from the broadcast records nearest the middle of the file, see :func:`almanac.from_ephemeris`). Files: RINEX 3.0x/4.00 navigation (plain or .gz),
     YUMA or SEM GPS almanacs, TLE sets (2- or 3-line). ``validity_days`` (almanac and TLE sources only) is the
     span either side of the almanac/TLE epoch in which states are returned (default 7 days); broadcast

@@ -76,7 +76,8 @@ _IMU = [
 ]
 _GNSS = [
     _f("gnss/t", "f8", ("M",), "s", "", "gnss", "receiver epochs since start (true GPS time)"),
-    _f("gnss/sat_id", "str", ("S",), "", "", "gnss", "satellite ids (RINEX 3: G GPS, C BDS, E Galileo, J QZSS, R GLONASS)"),
+    _f("gnss/sat_id", "str", ("S",), "", "", "gnss",
+       "satellite ids (RINEX 3: G GPS, C BDS, E Galileo, J QZSS, R GLONASS)"),
     _f("gnss/signals", "str", ("G",), "", "", "gnss", "signal names"),
     _f("gnss/frequency_hz", "f8", ("G",), "Hz", "", "gnss", "carrier frequency per signal"),
     _f("gnss/wavelength_m", "f8", ("G",), "m", "", "gnss", "carrier wavelength per signal"),
