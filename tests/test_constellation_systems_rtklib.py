@@ -122,3 +122,19 @@ def test_glonass_against_geph2pos(name, tmp_path):
     assert dpos.max() < 1e-3
     assert dvel.max() < 1e-3  # the forward difference is off by a |dv/dt| * 0.5 ms < 0.4 mm/s
     assert dclk.max() < 1e-15
+
+
+def test_broadcast_time_offsets_are_read_as_rtklib_reads_them(tmp_path):
+    """RINEX 3 'TIME SYSTEM CORR': GPS-UTC and Galileo-UTC as RTKLIB stores them (a0, a1, t_ref, week); RTKLIB
+    keeps -GLUT and GLGP in utc_glo. RINEX 4 '> STO' records of KMS3 give GAGP, GAUT and GPUT."""
+    const = load(DATA / FILES[0])
+    nav = _rtklib_nav(DATA / FILES[0], tmp_path)
+    off = const.time_offsets
+    for kind, ref in (("GPUT", nav.utc_gps), ("GAUT", nav.utc_gal)):
+        o = off[kind]
+        assert [o.a0, o.a1, o.t_ref[1], o.t_ref[0]] == [ref[0], ref[1], ref[2], ref[3]], kind
+    assert off["GLUT"].a0 == -nav.utc_glo[0] and off["GLGP"].a0 == nav.utc_glo[1]
+    assert off["GAGP"].a0 == pytest.approx(8.7311491370e-11, rel=0, abs=0)
+    sto = load(DATA / FILES[1]).time_offsets
+    assert set(sto) == {"GAGP", "GAUT", "GPUT"}
+    assert sto["GAGP"].a0 == 3.201421350241e-09 and sto["GAGP"].t_ref == (2213, 259200.0)

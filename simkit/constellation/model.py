@@ -41,6 +41,18 @@ class Klobuchar:
     beta: np.ndarray
 
 
+@dataclass(frozen=True)
+class TimeOffset:
+    """A broadcast system-time offset as the navigation file writes it (RINEX 3 'TIME SYSTEM CORR', RINEX 4
+    '> STO'): the difference named by ``kind`` (e.g. "GAGP": Galileo minus GPS time) at GPS time t is
+    ``a0 + a1 (t - t_ref)`` s; ``t_ref`` as (GPS week, seconds of week)."""
+
+    kind: str
+    a0: float
+    a1: float
+    t_ref: tuple
+
+
 @dataclass
 class GroupDelays:
     """Broadcast group-delay parameters of one name (e.g. ``"TGD"``), one entry per broadcast record.
@@ -79,6 +91,7 @@ class Constellation:
         self.ref_week = int(ref_week)
         self.klobuchar = dict(klobuchar or {})
         self._delays = dict(group_delays or {})
+        self.time_offsets: dict[str, TimeOffset] = {}  # broadcast system-time offsets by kind (read, not applied)
 
     def __len__(self) -> int:
         return len(self.sat_ids)
@@ -316,6 +329,7 @@ class CombinedConstellation(Constellation):
                          source, parts[0].ref_week, klob)
         self.parts = list(parts)
         self.kind = parts[0].kind
+        self.time_offsets = {k: v for p in reversed(parts) for k, v in p.time_offsets.items()}
         self._bounds = np.cumsum([0] + [len(p.sat_ids) for p in parts])
 
     @property

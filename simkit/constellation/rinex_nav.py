@@ -30,7 +30,7 @@ from .. import gpstime
 from ..errors import DataFileError
 from . import kepler
 from . import glonass
-from .model import CombinedConstellation, GroupDelays, KeplerConstellation, Klobuchar, Records
+from .model import CombinedConstellation, GroupDelays, KeplerConstellation, Klobuchar, Records, TimeOffset
 from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M, SYSTEMS
 
 KEPLER_SYSTEMS = "GCEJ"
@@ -98,6 +98,11 @@ def _header(lines, path):
         label = line[60:].strip()
         if label == "END OF HEADER":
             return i + 1, version, klob
+        if label == "TIME SYSTEM CORR" and line[:4].strip():
+            klob.setdefault("_sto", {}).setdefault(line[:4], TimeOffset(
+                line[:4], number(line[5:22], path, i + 1, "a0"), number(line[22:38], path, i + 1, "a1"),
+                (int(number(line[45:50], path, i + 1, "reference week")),
+                 number(line[38:45], path, i + 1, "reference time"))))
         if label == "IONOSPHERIC CORR" and line[:4] in ("GPSA", "GPSB", "BDSA", "BDSB"):
             vals = np.array([number(line[5 + 12 * k: 17 + 12 * k], path, i + 1, "ionospheric coefficient")
                              for k in range(4)])
@@ -204,6 +209,14 @@ def read(path, raw: bytes | None = None, systems: str | None = None):
     start, version, klob = _header(lines_of(raw[:head_end]) + [""], path)
     body = _rinex3_body if version < 4.0 else _rinex4_body
     ids, vals, delays, fnav, glo = body(raw, start, path, systems, klob)
+    offsets = klob.pop("_sto", {})
+    const = _assemble(path, klob, ids, vals, delays, fnav, glo, systems)
+    const.time_offsets = offsets
+    return const
+
+
+def _assemble(path, klob, ids, vals, delays, fnav, glo, systems):
+    """The constellation object from the parsed records: Keplerian, GLONASS, or both combined."""
     if not ids and not glo:
         wanted = ", ".join(SYSTEM_NAMES[c] for c in systems)
         raise DataFileError(path, f"no broadcast ephemeris records found for {wanted or 'any system'}")
@@ -254,6 +267,12 @@ def _rinex4_body(raw, start, path, systems, klob):
             continue
         if rtype == "ION" and sat[0] not in klob and (msg, sat[0]) in (("LNAV", "G"), ("D1D2", "C")):
             klob[sat[0]] = _ion4(block, path, ln + 1)
+        elif rtype == "STO" and len(block) >= 2:
+            kind = block[0][24:28]
+            week, sow = gpstime.normalize(0, _epoch_seconds(block[0][4:23], path, ln + 1))
+            klob.setdefault("_sto", {}).setdefault(kind, TimeOffset(
+                kind, number(block[1][23:42], path, ln + 2, "a0"), number(block[1][42:61], path, ln + 2, "a1"),
+                (int(week), float(sow))))
         elif rtype == "EPH" and (sat[0], msg) in _KEPLER_MESSAGES:
             _check_len(block, ln + 1, path)
             ids.append(_sat_id(block[0][:3]))
