@@ -91,3 +91,19 @@ def test_rtklib_moving_base_on_the_five_system_export_fixes_as_often_with_no_wro
     print(f"\nRTKLIB moving base, fixed / epochs / wrong: GPS+BDS {found['gc']}, five systems {found['five']}")
     assert found["five"][2] == 0 and found["gc"][2] == 0
     assert found["five"][0] >= found["gc"][0] > 0.8 * found["gc"][1]
+
+
+def test_kf15_dd_uses_galileo_and_leaves_glonass_out(tmp_path):
+    """kf15_dd on quickstart: with GLONASS G1C added, the DD rows are exactly those of GPS+BDS (the GPS/BDS
+    observables are bit-identical and G1C gives none); with Galileo E1C added there are more."""
+    from simkit.estimators import SOLVERS as FILTERS
+
+    rows = {}
+    for label, sigs in (("gc", '["L1C","B1I"]'), ("glo", '["L1C","B1I","G1C"]'), ("gal", '["L1C","B1I","E1C"]')):
+        path = simkit.run("quickstart", out=tmp_path / f"{label}.h5", overrides=[f"gnss.signals={sigs}"])
+        with simkit.open(path) as ds:
+            sol = FILTERS["kf15_dd"](ds, {})
+        assert sol.config["dd_epochs"] > 40 and sol.config["dd_rejected"] == 0
+        rows[label] = sol.extras["dd_rows"]
+    np.testing.assert_array_equal(rows["glo"], rows["gc"])
+    assert rows["gal"].sum() > rows["gc"].sum() + 200
