@@ -147,7 +147,7 @@ def _scenario_file(scenario) -> Path | None:
 def _sky(sc: Scenario) -> Sky:
     """The constellation stage: load the sources, refuse duplicates and a sky with nothing to see."""
     try:
-        sky = load_sky(sc.gnss.sources)
+        sky = load_sky(sc.gnss.sources, sc.gnss.nav_systems)
     except DataFileError as exc:
         index = next((i for i, s in enumerate(sc.gnss.sources) if str(s) in exc.path or exc.path in str(s)), 0)
         raise ScenarioError(f"gnss.constellation[{index}].source", str(exc), sc.source) from None

@@ -68,7 +68,7 @@ def test_kepler_equation_is_solved_or_flagged_nan():
 
 
 def test_broadcast_validity_span_is_the_fit_interval_around_the_first_and_last_toe():
-    c = load(BRDM)
+    c = load(BRDM, systems="GC")  # GPS and BDS: +-2 h / +-1 h about toe
     first, last = c.validity_span()
     assert first[0] == 2416 and last[0] == 2416
     # states exist just inside the span and nowhere just outside it
@@ -79,6 +79,14 @@ def test_broadcast_validity_span_is_the_fit_interval_around_the_first_and_last_t
     # the file holds day 117 (2026-04-27, GPS week 2416 day 1); fit intervals reach at most 2 h beyond it
     day = 86400.0
     assert day - 7200.0 <= first[1] <= day and 2 * day - 600.0 <= last[1] <= 2 * day + 7200.0
+    # Galileo records hold for 4 h after their toe, GLONASS +-30 min about tb: the whole file's span
+    gal, glo = load(BRDM, systems="E"), load(BRDM, systems="R")
+    toe = gal.records.params[gal.records.healthy, 0] + gal.ref_week * 604800.0
+    assert gpstime.diff_seconds(*gal.validity_span()[0], 0, 0.0) == toe.min()
+    assert gpstime.diff_seconds(*gal.validity_span()[1], 0, 0.0) == toe.max() + 4 * 3600.0
+    assert load(BRDM).validity_span() == (first, gal.validity_span()[1])
+    tb = glo.records.params[glo.records.healthy, 0] + glo.ref_week * 604800.0
+    assert gpstime.diff_seconds(*glo.validity_span()[1], 0, 0.0) == tb.max() + 1800.0
 
 
 def test_almanac_span_is_the_copy_nearest_the_query_and_nominal_has_none():
@@ -93,7 +101,7 @@ def test_almanac_span_is_the_copy_nearest_the_query_and_nominal_has_none():
 
 
 def test_times_no_satellite_covers_raise_one_error_naming_source_and_span():
-    c = load(BRDM)
+    c = load(BRDM, systems="GC")
     with pytest.raises(NoStateError, match=r"BRDM.*no satellite has a state from 2026-04-29 23:59:42 UTC to 2026-04-30 00:58:42 UTC; "
                                            r"the source covers 2026-04-26 21:59:42 UTC to 2026-04-28 01:59:26 UTC") as err:
         c.require_states(2416, 4 * 86400.0 + np.arange(0.0, 3600.0, 60.0))  # Thursday 2026-04-30 00:00 GPST

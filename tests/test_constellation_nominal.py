@@ -18,11 +18,12 @@ from scipy.optimize import minimize_scalar
 
 from simkit.constellation import load
 
-MU = {"G": 3.986005e14, "C": 3.986004418e14}            # each system's own constants (constellation/systems.py)
-OMEGA_E = {"G": 7.2921151467e-5, "C": 7.292115e-5}
+MU = {"G": 3.986005e14, "C": 3.986004418e14, "E": 3.986004418e14, "R": 3.9860044e14}  # each system's own
+OMEGA_E = {"G": 7.2921151467e-5, "C": 7.292115e-5, "E": 7.2921151467e-5, "R": 7.292115e-5}  # (ICDs)
 J2, RE = 1.08262668e-3, 6378137.0
 WEEK = 2416                                              # any week: nominal orbits are valid at every epoch
-SOURCES = ["nominal:gps", "nominal:bds", "nominal:bds2", "nominal:bds3", "nominal:gps+bds"]
+SOURCES = ["nominal:gps", "nominal:bds", "nominal:bds2", "nominal:bds3", "nominal:gps+bds", "nominal:gal",
+           "nominal:glo", "nominal:gps+bds+gal+glo"]
 
 
 def sidereal_day(system):
@@ -216,3 +217,40 @@ def test_bds_meo_ground_track_repeats_after_13_revolutions_in_7_sidereal_days(so
     print(f"{source}: {meo.size} MEO; ground track 7 sidereal days later within {off * 1e3:.1f} mm of the "
           f"first day's")
     assert off < 1000.0
+
+
+@pytest.mark.parametrize("source, system, a_km, inc_deg, revs, days", [
+    ("nominal:gal", "E", 29600.318, 56.0, 17, 10),   # Galileo OS SDD: Walker 24/3/1, 17 revolutions in 10 days
+    # GLONASS ICD: draconic period 11 h 15 min 44 s (a by Kepler's third law), 17 revolutions in 8 days
+    ("nominal:glo", "R", (MU["R"] * (40544.0 / (2 * np.pi)) ** 2) ** (1 / 3) / 1e3, 64.8, 17, 8)])
+def test_galileo_and_glonass_walker_geometry_and_ground_track_repeat(source, system, a_km, inc_deg, revs, days):
+    c = load(source)
+    t = np.arange(0.0, 86400.0, 60.0)
+    pos, ids, _ = states(c, t, system)
+    assert len(ids) == 24
+    r = np.linalg.norm(pos, axis=-1)
+    np.testing.assert_allclose(r, a_km * 1e3, rtol=1e-12)
+    p_i = inertial(pos, t, system)
+    normal = np.cross(p_i[0], p_i[1])
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    np.testing.assert_allclose(np.degrees(np.arccos(normal[:, 2])), inc_deg, atol=0.005)  # + node regression
+    nodes = np.degrees(np.arctan2(normal[:, 0], -normal[:, 1])) % 360.0  # right ascension of each node
+    planes = np.round((nodes - nodes[0]) % 360.0 / 120.0) % 3
+    assert np.array_equal(np.bincount(planes.astype(int)), [8, 8, 8])
+    # the ground track repeats after `days` days relative to the node: positions coincide after that span
+    lag = days * repeat_day(a_km * 1e3, system, np.radians(inc_deg))
+    later = states(c, t[:60] + lag, system)[0]
+    assert np.linalg.norm(later - pos[:60], axis=-1).max() < 0.01
+    half = 2.0 * np.pi * np.sqrt((a_km * 1e3) ** 3 / MU[system])
+    assert abs(revs * half / (days * sidereal_day(system)) - 1.0) < 3 * j2_scale(a_km * 1e3)
+
+
+def test_nominal_glonass_channels_are_the_iac_table_and_antipodal_slots_share_them():
+    c = load("nominal:glo")
+    k = dict(zip(c.sat_ids, c.channels.tolist()))
+    assert all(k[f"R{s:02d}"] == k[f"R{s + 4:02d}"] for p in range(3) for s in range(8 * p + 1, 8 * p + 5))
+    assert len(set(k.values())) == 12 and set(k.values()) <= set(range(-7, 7))  # 12 pairs within -7..6
+    # the same table the operational satellites of the 2026 broadcast file carry in their slots
+    brdm = load("BRDM00DLR_S_20261170000_01D_MN.rnx.gz", systems="R")
+    same = [s for s in brdm.sat_ids if s in k]
+    assert len(same) >= 20 and all(k[s] == brdm.channels[brdm.sat_ids.index(s)] for s in same)

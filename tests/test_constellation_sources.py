@@ -22,8 +22,13 @@ def test_rinex4_records_and_bds_orbit_types_match_cnav1_sattype():
     lines = gzip.open(path, "rt").read().splitlines()
     heads = [ln.split() for ln in lines if ln.startswith("> EPH")]
     n_used = sum(h[2][0] in "GC" and h[3] in ("LNAV", "D1", "D2") for h in heads)
-    const = load(path)
+    const = load(path, systems="GC")
     assert len(const.records.sat) == n_used
+    kepler_all = sum((h[2][0], h[3]) in {("G", "LNAV"), ("C", "D1"), ("C", "D2"), ("E", "INAV"), ("E", "FNAV"),
+                                         ("J", "LNAV")} for h in heads)
+    everything = load(path)
+    assert len(everything.records.sat) == kepler_all > n_used
+    assert len(everything.part("R").records.sat) == sum(h[2][0] == "R" and h[3] == "FDMA" for h in heads)
     sat_type = {}
     for i, ln in enumerate(lines):
         if ln.startswith("> EPH C") and ln.split()[3] == "CNV1":

@@ -12,7 +12,8 @@ from conftest import DATA
 
 SITE = ["--lat", "34.25", "--lon", "108.95", "--start", "2026-04-27T06:00:00Z"]
 BRDM = "BRDM00DLR_S_20261170000_01D_MN.rnx.gz"
-BRDM_SPAN = "covers 2026-04-26 21:59:42 UTC to 2026-04-28 01:59:26 UTC"  # first toe - 2 h .. last toe + 2 h
+# first GPS toe - 2 h .. last Galileo toe + 4 h (a Galileo record holds for 4 h after its toe)
+BRDM_SPAN = "covers 2026-04-26 21:59:42 UTC to 2026-04-28 03:49:42 UTC"
 YUMA = str(DATA / "yuma" / "almanac.yuma.week0149.405504.txt")     # toa 2022-02-17 16:38:24 GPST
 
 BAD = [

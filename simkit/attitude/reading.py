@@ -33,14 +33,23 @@ class FileData:
     sat_clock: np.ndarray
 
 
+# GLONASS FDMA signals are left out of the double differences and integer fixing: a DD of carriers on two
+# frequencies is lambda_i N_i - lambda_j N_j, not a wavelength times an integer, and the receiver's inter-channel
+# biases (which RTKLIB can estimate, glomodear) are not modelled here. "all" skips them; naming one is an error.
+FDMA_EXCLUDED = ("GLONASS FDMA signals are not used for DD attitude: DD ambiguities across frequency channels "
+                 "are not integers (no inter-channel bias handling)")
+
+
 def _signals(ds, wanted: str) -> tuple:
     have = gnss_signals(ds)
     if wanted == "all":
-        return have
+        return tuple(s for s in have if s not in gsig.SIGNALS or not gsig.get(s).is_fdma)
     names = tuple(s.strip() for s in wanted.split(",") if s.strip())
     for s in names:
         if s not in have:
             raise AttitudeInputError("estimator.signals", f"{s!r} is not in the file; expected some of {have}")
+        if gsig.get(s).is_fdma:
+            raise AttitudeInputError("estimator.signals", f"{s!r}: {FDMA_EXCLUDED}")
     return names
 
 

@@ -25,9 +25,10 @@ HEIGHT_RANGE_M = (-11000.0, 20.0e6)  # deepest ocean floor .. below the GNSS orb
 
 
 def add_parser(sub):
-    p = sub.add_parser("sky", help="visible GPS/BDS satellites, DOPs and a sky plot for a place and time span",
+    p = sub.add_parser("sky", help="visible satellites per system, DOPs and a sky plot for a place and time span",
                        description="Load a constellation (file, bundled name or nominal:gps / nominal:bds / "
-                                   "nominal:bds2 / nominal:bds3 / nominal:gps+bds), evaluate it from one place "
+                                   "nominal:bds2 / nominal:bds3 / nominal:gps+bds / nominal:gal / nominal:glo / "
+                                   "nominal:gps+bds+gal+glo), evaluate it from one place "
                                    "and print visible counts and DOPs per step; optionally save a sky plot.")
     p.add_argument("source", nargs="?", default=None,
                    help="constellation source (default: the bundled 2026 BRDM broadcast file)")
@@ -41,6 +42,9 @@ def add_parser(sub):
     p.add_argument("--mask", type=float, default=10.0, help="elevation mask, deg (-90..90, default 10)")
     p.add_argument("--validity-days", type=float, default=None,
                    help="almanac/TLE sources: days either side of their epoch with valid states (default 7)")
+    p.add_argument("--systems", default=None, metavar="LETTERS",
+                   help="RINEX navigation sources: the systems to use, e.g. GC (GPS+BDS) or GCEJR (default: every "
+                        "GPS, BDS, Galileo, QZSS and GLONASS record of the file)")
     p.add_argument("--plot", metavar="OUT.png", help="save a sky plot (needs matplotlib: the 'plot' extra)")
     p.add_argument("--environment", metavar="FILE.toml",
                    help="a TOML file with an [environment] table (a scenario): the site sees its buildings and "
@@ -62,7 +66,7 @@ def run(args) -> int:
 
     check_outputs([("--plot", args.plot, False)], [args.source])
     start = _start(args.start)
-    const = sc.load(args.source or sc.DEFAULT_SKY, validity_days=args.validity_days)
+    const = sc.load(args.source or sc.DEFAULT_SKY, validity_days=args.validity_days, systems=args.systems)
     week, sow0 = gpstime.utc_to_gps(start)
     sow = sow0 + np.arange(_step_count(args, len(const))) * args.step
     const.require_states(week, sow)  # NoStateError: names the source and the span it covers
@@ -96,6 +100,8 @@ def _check_numbers(args):
         raise ScenarioError("--hours", f"found {args.hours:g}; expected a span >= 0 h")
     if not (math.isfinite(args.step) and args.step > 0):
         raise ScenarioError("--step", f"found {args.step:g}; expected a step > 0 s")
+    if args.systems is not None and (not args.systems or set(args.systems) - set("GCEJR")):
+        raise ScenarioError("--systems", f"found {args.systems!r}; expected letters among G, C, E, J, R")
     days = args.validity_days
     if days is not None and not (math.isfinite(days) and days > 0):
         raise ScenarioError("--validity-days", f"found {days:g}; expected a number of days > 0")

@@ -1,4 +1,5 @@
-"""GPS and BeiDou constellations: broadcast ephemerides (RINEX 3/4), YUMA/SEM almanacs, TLEs, nominal slots.
+"""GPS, BeiDou, Galileo, QZSS and GLONASS constellations: broadcast ephemerides (RINEX 3/4; GLONASS state vectors
+integrated as in :mod:`.glonass`), YUMA/SEM almanacs, TLEs, nominal slots.
 
 ``load(source)`` returns a :class:`Constellation` with ``.sat_ids``, ``.system``, ``.orbit_type`` and
 ``.state(gps_week, gps_sow[, velocity=True])``; :mod:`.geometry` turns states into what a receiver sees

@@ -41,6 +41,18 @@ class Klobuchar:
     beta: np.ndarray
 
 
+@dataclass(frozen=True)
+class TimeOffset:
+    """A broadcast system-time offset as the navigation file writes it (RINEX 3 'TIME SYSTEM CORR', RINEX 4
+    '> STO'): the difference named by ``kind`` (e.g. "GAGP": Galileo minus GPS time) at GPS time t is
+    ``a0 + a1 (t - t_ref)`` s; ``t_ref`` as (GPS week, seconds of week)."""
+
+    kind: str
+    a0: float
+    a1: float
+    t_ref: tuple
+
+
 @dataclass
 class GroupDelays:
     """Broadcast group-delay parameters of one name (e.g. ``"TGD"``), one entry per broadcast record.
@@ -79,9 +91,15 @@ class Constellation:
         self.ref_week = int(ref_week)
         self.klobuchar = dict(klobuchar or {})
         self._delays = dict(group_delays or {})
+        self.time_offsets: dict[str, TimeOffset] = {}  # broadcast system-time offsets by kind (read, not applied)
 
     def __len__(self) -> int:
         return len(self.sat_ids)
+
+    @property
+    def channels(self) -> np.ndarray:
+        """(S,) int: GLONASS FDMA frequency numbers k (0 for CDMA satellites)."""
+        return np.zeros(len(self.sat_ids), dtype=np.int64)
 
     def __repr__(self) -> str:
         kinds = {s: int(np.sum(self.system == s)) for s in np.unique(self.system)}
@@ -211,13 +229,17 @@ def describe_span(span) -> str:
 class Records:
     """Keplerian records: ``params`` (R, len(kepler.FIELDS)), ``sat`` (R,) index, ``healthy`` (R,) bool,
     ``half_width`` (R,) s validity either side of toe (np.inf: always valid), ``period`` (R,) s or None: a
-    record repeats with this period (10-bit almanac weeks: 1024 weeks) and each query uses its nearest copy."""
+    record repeats with this period (10-bit almanac weeks: 1024 weeks) and each query uses its nearest copy.
+    ``after_toe`` (R,) bool or None: the record is valid only after its toe, for ``half_width`` s, and the latest
+    such record is used instead of the nearest (Galileo: a navigation batch is broadcast after its toe and holds
+    for 4 h; RTKLIB's ``seleph`` takes the latest I/NAV record with toe before t the same way)."""
 
     params: np.ndarray
     sat: np.ndarray
     healthy: np.ndarray
     half_width: np.ndarray
     period: np.ndarray | None = None
+    after_toe: np.ndarray | None = None
 
 
 class KeplerConstellation(Constellation):
@@ -236,8 +258,10 @@ class KeplerConstellation(Constellation):
         super().__init__(sat_ids, otype, source, ref_week, klobuchar, group_delays)
         self.kind = kind
         self.records = records
+        self.channel = np.zeros(len(sat_ids), dtype=np.int64)  # FDMA channels (nominal GLONASS sets them)
         toe = p[:, kepler.COL["toe"]]
         period = records.period if records.period is not None else np.full(len(toe), np.inf)
+        after = records.after_toe if records.after_toe is not None else np.zeros(len(toe), bool)
         self._sel = []
         for s in range(len(sat_ids)):
             rows = np.flatnonzero((records.sat == s) & records.healthy)
@@ -245,7 +269,12 @@ class KeplerConstellation(Constellation):
             per = np.unique(period[rows])
             if per.size > 1:
                 raise ValueError(f"{sat_ids[s]}: records with different repeat periods")
-            self._sel.append((rows, toe[rows], records.half_width[rows], per[0] if per.size else np.inf))
+            self._sel.append((rows, toe[rows], records.half_width[rows], per[0] if per.size else np.inf,
+                              bool(after[rows].all()) if rows.size else False))
+
+    @property
+    def channels(self) -> np.ndarray:
+        return self.channel
 
     def select(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Record index (N, S) for times ``t`` (N, S) (GPS s since ``ref_week``, column s for satellite s): the
@@ -253,12 +282,18 @@ class KeplerConstellation(Constellation):
         Also returns the times to evaluate at (``t`` moved by whole periods for repeating almanac records)."""
         idx = np.full(t.shape, -1, dtype=np.int64)
         t_eval = np.array(t, dtype=float)
-        for s, (rows, toe, half, period) in enumerate(self._sel):
+        for s, (rows, toe, half, period, after) in enumerate(self._sel):
             if rows.size == 0:
                 continue
             ts = t_eval[:, s]  # a view: shifting it shifts t_eval
             if np.isfinite(period):
                 ts -= period * np.round((ts - toe[0]) / period)
+            if after:  # the latest toe strictly before t, up to half_width after it
+                j = np.searchsorted(toe, ts, side="left") - 1
+                pick = np.maximum(j, 0)
+                ok = (j >= 0) & (ts - toe[pick] <= half[pick])
+                idx[:, s] = np.where(ok, rows[pick], -1)
+                continue
             j = np.searchsorted(toe, ts, side="right")  # toe[j-1] <= t < toe[j]
             lo = np.clip(j - 1, 0, rows.size - 1)
             hi = np.clip(j, 0, rows.size - 1)
@@ -271,9 +306,63 @@ class KeplerConstellation(Constellation):
         r = self.records
         toe = r.params[r.healthy, kepler.COL["toe"]]
         half = r.half_width[r.healthy]
+        after = r.after_toe[r.healthy] if r.after_toe is not None else np.zeros(toe.size, bool)
         period = np.unique(r.period[r.healthy]) if r.period is not None else np.array([np.inf])
-        return toe - half, toe + half, float(period.min()) if period.size else np.inf
+        return np.where(after, toe, toe - half), toe + half, float(period.min()) if period.size else np.inf
 
     def _evaluate(self, t, velocity):
         idx, t_eval = self.select(t)
         return kepler.propagate(self.records.params, idx.ravel(), t_eval.ravel(), velocity)
+
+
+class CombinedConstellation(Constellation):
+    """Several constellations read from one source (a mixed navigation file: Keplerian systems and GLONASS),
+    seen as one: ``sat_ids`` are the parts' in order, and all parts count seconds from the same ``ref_week``.
+    ``records`` is the first (Keplerian) part's record table, whose satellite indices are valid in ``sat_ids``
+    because that part comes first."""
+
+    def __init__(self, parts: list[Constellation], source: str):
+        if len({p.ref_week for p in parts}) != 1:
+            raise ValueError("combined constellations must share their reference week")
+        klob = {k: v for p in reversed(parts) for k, v in p.klobuchar.items()}
+        super().__init__([s for p in parts for s in p.sat_ids], np.concatenate([p.orbit_type for p in parts]),
+                         source, parts[0].ref_week, klob)
+        self.parts = list(parts)
+        self.kind = parts[0].kind
+        self.time_offsets = {k: v for p in reversed(parts) for k, v in p.time_offsets.items()}
+        self._bounds = np.cumsum([0] + [len(p.sat_ids) for p in parts])
+
+    @property
+    def channels(self) -> np.ndarray:
+        return np.concatenate([p.channels for p in self.parts])
+
+    def part(self, system: str):
+        """The part holding satellites of ``system`` ('R' -> the GLONASS part), or None."""
+        return next((p for p in self.parts if system in set(p.system)), None)
+
+    @property
+    def records(self):
+        return self.parts[0].records
+
+    def _intervals(self):
+        spans = [p._intervals() for p in self.parts]
+        return (np.concatenate([s[0] for s in spans]), np.concatenate([s[1] for s in spans]),
+                min(s[2] for s in spans))
+
+    def _evaluate(self, t, velocity):
+        n = t.shape[0]
+        outs = []
+        for p, a, b in zip(self.parts, self._bounds[:-1], self._bounds[1:]):
+            res = p._evaluate(np.ascontiguousarray(t[:, a:b]), velocity)
+            outs.append([r.reshape((n, b - a) + r.shape[1:]) for r in res])
+        return tuple(np.concatenate(cols, axis=1).reshape((-1,) + cols[0].shape[2:]) for cols in zip(*outs))
+
+    def group_delay_names(self) -> list[str]:
+        return sorted({n for p in self.parts for n in p.group_delay_names()})
+
+    def group_delays(self, gps_week=None, gps_sow=None) -> dict[str, np.ndarray]:
+        out: dict[str, np.ndarray] = {}
+        for p, a, b in zip(self.parts, self._bounds[:-1], self._bounds[1:]):
+            for name, vals in p.group_delays(gps_week, gps_sow).items():
+                out.setdefault(name, np.full(len(self.sat_ids), np.nan))[a:b] = vals
+        return out

@@ -1,7 +1,8 @@
 """Nominal constellations from published slot definitions (circular orbits; no clocks).
 
 Names for ``load("nominal:<name>")``: ``gps`` (24-slot baseline), ``bds2`` (5 GEO + 5 IGSO + 4 MEO), ``bds3``
-(24 MEO Walker 24/3/1 + 3 GEO + 3 IGSO), ``bds`` (= ``bds3``), ``gps+bds`` (gps and bds3 together).
+(24 MEO Walker 24/3/1 + 3 GEO + 3 IGSO), ``bds`` (= ``bds3``), ``gps+bds`` (gps and bds3 together), ``gal``
+(Galileo Walker 24/3/1), ``glo`` (GLONASS 24 slots, with the slots' FDMA channels), ``gps+bds+gal+glo``.
 
 GPS: SPS Performance Standard (2001 Table 3-1, 2008/2020 Table 3.1-1) baseline 24-slot table: RAAN and argument of
 latitude per slot at the defined epoch 1 July 1993 00:00 UTC, Greenwich hour angle 18 h 36 min 14.4 s, i = 55 deg,
@@ -27,8 +28,9 @@ from .. import gpstime
 from ..earth import A as R_EARTH
 from ..errors import DataFileError
 from . import kepler
+from . import glonass
 from .model import KeplerConstellation, Records
-from .systems import BDS, GPS
+from .systems import BDS, GAL, GPS, System
 
 J2 = 1.08262668e-3  # WGS-84 (EGM96) second zonal harmonic
 DEG = np.pi / 180.0
@@ -58,6 +60,16 @@ BDS_IGSO = {6: (118.0, 0.0), 7: (118.0, 120.0), 8: (118.0, 240.0), 9: (95.0, 0.0
 # BDS-2 MEO in the same Walker pattern: PRN -> (plane, slot)
 BDS2_MEO = {11: (0, 0), 12: (0, 1), 13: (1, 0), 14: (1, 1)}
 BDS_REF = (BDS.week_offset, BDS.time_offset_s)  # BDT origin, 2006-01-01 00:00 UTC, as GPS (week, sow)
+GST_REF = (1024, 0.0)                           # GST origin, 1999-08-22 00:00 GPST (GPS week 1024)
+GAL_A = 29600.318e3
+GAL_INC = 56.0 * DEG
+GLO_PERIOD_S = 11 * 3600.0 + 15 * 60.0 + 44.0   # ICD nominal draconic period, 11 h 15 min 44 s
+GLO_A = (glonass.MU * (GLO_PERIOD_S / (2.0 * np.pi)) ** 2) ** (1.0 / 3.0)  # Kepler's third law: 25,508 km
+GLO_INC = 64.8 * DEG
+GLO_SYS = System("R", "GLONASS", glonass.MU, glonass.OMEGA_E, np.inf, 0.0, 0)
+# frequency channel per slot, as the IAC assigns them (antipodal slots share one), R01..R24
+GLO_CHANNELS = dict(zip([f"R{k:02d}" for k in range(1, 25)],
+                        [1, -4, 5, 6, 1, -4, 5, 6, -2, -7, 0, -1, -2, -7, 0, -1, 4, -3, 3, 2, 4, -3, 3, 2]))
 
 
 def _j2_node_rate(a, inc, mu):
@@ -114,7 +126,37 @@ def _bds2():
     return _bds(BDS2_MEO, (1, 2, 3, 4, 5), (6, 7, 8, 9, 10))
 
 
-_BUILDERS = {"gps": [_gps], "bds2": [_bds2], "bds3": [_bds3], "bds": [_bds3], "gps+bds": [_gps, _bds3]}
+def _walker(prefix, system, a, inc, planes, per_plane, phase_deg, revs, days, slot_sign=1.0):
+    """A Walker constellation: plane p's node at p * 360/planes deg (plane 1 at 0 at the reference epoch), slot
+    j (0-based) of plane p at argument of latitude slot_sign * j * 360/per_plane + p * phase_deg; ``revs``
+    revolutions in ``days`` days relative to the J2-precessing node; ids prefix + 01.. in plane order."""
+    rate = _j2_node_rate(a, inc, system.mu)
+    n = revs / days * (system.omega_e - rate)
+    rows = []
+    for p in range(planes):
+        for j in range(per_plane):
+            u = slot_sign * j * 360.0 / per_plane + p * phase_deg
+            rows.append((f"{prefix}{p * per_plane + j + 1:02d}", a, inc, p * 360.0 / planes * DEG, u * DEG, n, rate))
+    return rows
+
+
+def _gal():
+    # Galileo OS SDD: Walker 24/3/1, a = 29,600.318 km, i = 56 deg, ground track repeating after 17 revolutions
+    # in 10 days; plane nodes and the slot -> PRN map are ours (E01-E08 plane A, ...), reference GST week 0
+    rows = _walker("E", GAL, GAL_A, GAL_INC, 3, 8, 15.0, 17.0, 10.0)
+    return GST_REF[0], _records(rows, GAL, GST_REF[1])
+
+
+def _glo():
+    # GLONASS ICD 2008 3.1: 3 planes 120 deg apart, 8 slots 45 deg apart, planes shifted 15 deg in argument of
+    # latitude, slot numbers increasing against the motion, i = 64.8 deg, 11 h 15 min 44 s period, 17 revolutions
+    # in 8 days; plane 1's node at 0 deg at the reference epoch is ours. Kepler circles, not the PZ-90 integration.
+    rows = _walker("R", GLO_SYS, GLO_A, GLO_INC, 3, 8, 15.0, 17.0, 8.0, slot_sign=-1.0)
+    return GST_REF[0], _records(rows, GLO_SYS, GST_REF[1])
+
+
+_BUILDERS = {"gps": [_gps], "bds2": [_bds2], "bds3": [_bds3], "bds": [_bds3], "gps+bds": [_gps, _bds3],
+             "gal": [_gal], "glo": [_glo], "gps+bds+gal+glo": [_gps, _bds3, _gal, _glo]}
 NAMES = tuple(_BUILDERS)
 
 
@@ -138,4 +180,6 @@ def nominal(name: str) -> KeplerConstellation:
     ids = [ids[k] for k in order]
     n = len(ids)
     records = Records(params[order], np.arange(n), np.ones(n, bool), np.full(n, np.inf))
-    return KeplerConstellation(ids, records, f"nominal:{key}", ref_week, "nominal")
+    const = KeplerConstellation(ids, records, f"nominal:{key}", ref_week, "nominal")
+    const.channel = np.array([GLO_CHANNELS.get(s, 0) for s in ids], dtype=np.int64)
+    return const

@@ -1,6 +1,13 @@
-"""RINEX 3.0x / 4.00 navigation files -> broadcast ephemeris constellation (GPS LNAV, BDS D1/D2).
+"""RINEX 3.0x / 4.00 navigation files -> broadcast ephemeris constellation (GPS LNAV, BDS D1/D2, Galileo I/NAV
+and F/NAV, QZSS LNAV, GLONASS FDMA state vectors).
 
-Mixed multi-GNSS files are accepted; only GPS and BDS Keplerian records are kept (other systems are skipped).
+Mixed multi-GNSS files are accepted; GPS, BDS, Galileo, QZSS and GLONASS records are kept (SBAS and NavIC are
+skipped), or only the systems named in ``systems``. Galileo: I/NAV and F/NAV records are both read; a satellite's
+orbit and clock come from its I/NAV records (clock referred to E1/E5b, as RTKLIB's default), from F/NAV only when it
+has no I/NAV record; BGD(E1,E5a) and BGD(E1,E5b) come from the same records. Galileo and QZSS toe/toc are in GST
+and QZSST, which RINEX aligns with GPS weeks and GPST (their broadcast offsets to GPST, a few ns, are left out, as
+RTKLIB does for orbits). GLONASS epochs are UTC and become GPS time with the leap seconds at that instant
+(:mod:`.glonass`).
 Satellite ids may be written "C03" or "C 3". RINEX 4 ``> EPH`` records of type LNAV (GPS) and D1/D2 (BDS) are
 used for orbits; BDS CNV1/CNV2 records are read only for their group delays (TGD_B1Cp, TGD_B2ap, ISC_B1Cd,
 ISC_B2ad); GPS CNAV/CNV2 and BDS CNV3 records are skipped. Klobuchar coefficients come from the RINEX 3 header
@@ -15,15 +22,19 @@ because it is much faster than georinex on the same files (figure in docs/benchm
 """
 from __future__ import annotations
 
-from datetime import date
+from datetime import date, timedelta
 
 import numpy as np
 
 from .. import gpstime
 from ..errors import DataFileError
 from . import kepler
-from .model import GroupDelays, KeplerConstellation, Klobuchar, Records
+from . import glonass
+from .model import CombinedConstellation, GroupDelays, KeplerConstellation, Klobuchar, Records, TimeOffset
 from .systems import GEO_MAX_INC_RAD, GEO_MIN_A_M, SYSTEMS
+
+KEPLER_SYSTEMS = "GCEJ"
+ALL_SYSTEMS = "GCEJR"
 from .textfile import lines_of, number, read_bytes
 
 N_FIELDS = 31  # af0 af1 af2 + 7 lines x 4 broadcast-orbit values
@@ -87,6 +98,11 @@ def _header(lines, path):
         label = line[60:].strip()
         if label == "END OF HEADER":
             return i + 1, version, klob
+        if label == "TIME SYSTEM CORR" and line[:4].strip():
+            klob.setdefault("_sto", {}).setdefault(line[:4], TimeOffset(
+                line[:4], number(line[5:22], path, i + 1, "a0"), number(line[22:38], path, i + 1, "a1"),
+                (int(number(line[45:50], path, i + 1, "reference week")),
+                 number(line[38:45], path, i + 1, "reference time"))))
         if label == "IONOSPHERIC CORR" and line[:4] in ("GPSA", "GPSB", "BDSA", "BDSB"):
             vals = np.array([number(line[5 + 12 * k: 17 + 12 * k], path, i + 1, "ionospheric coefficient")
                              for k in range(4)])
@@ -96,11 +112,12 @@ def _header(lines, path):
     raise DataFileError(path, "no 'END OF HEADER' line: truncated header", len(lines))
 
 
-def _rinex3_records(buf: np.ndarray, nl: np.ndarray, start: int, lines_total: int, path):
+def _rinex3_records(buf: np.ndarray, nl: np.ndarray, start: int, lines_total: int, path, systems=ALL_SYSTEMS):
     """Vectorised RINEX 3 body reader on the raw bytes ``buf`` (uint8) with newline offsets ``nl``.
 
-    Checks every record's line count, then returns (0-based line numbers of the GPS/BDS record starts,
-    (R, 31) values). ``start`` is the first body line. A bad field makes the per-record reader name its line.
+    Checks every record's line count, then returns (0-based line numbers of the Keplerian record starts of
+    ``systems``, (R, 31) values, 0-based line numbers of the GLONASS record starts when 'R' is in ``systems``).
+    ``start`` is the first body line. A bad field makes the per-record reader name its line.
     """
     line_start = np.concatenate(([0], nl + 1))[: nl.size + 1]
     line_end = np.append(nl, buf.size)
@@ -125,9 +142,11 @@ def _rinex3_records(buf: np.ndarray, nl: np.ndarray, start: int, lines_total: in
             sat = bytes(buf[line_start[i]:line_start[i] + 3]).decode("latin-1").strip()
             raise DataFileError(path, f"record for {sat} starting here has {lengths[k]} lines, "
                                 f"expected {' or '.join(map(str, allowed))} (truncated or malformed)", i + 1)
-    rec = start + starts[(sys == ord("G")) | (sys == ord("C"))]
+    kepler_sys = np.isin(sys, [ord(c) for c in KEPLER_SYSTEMS if c in systems])
+    rec = start + starts[kepler_sys]
+    glo = start + starts[sys == ord("R")] if "R" in systems else np.zeros(0, np.int64)
     if rec.size == 0:
-        return rec, np.zeros((0, N_FIELDS))
+        return rec, np.zeros((0, N_FIELDS)), glo
     rows = rec[:, None] + _SLOT_LINE[None, :]  # (R, 31) line numbers
     col0 = line_start[rows] + _SLOT_COL[None, :]
     pos = col0[..., None] + np.arange(19)  # (R, 31, 19) byte offsets
@@ -146,7 +165,7 @@ def _rinex3_records(buf: np.ndarray, nl: np.ndarray, start: int, lines_total: in
         for i in rec:  # raises with the line of the first bad field
             _values(text[i:i + 8], path, i + 1)
     vals[blank] = 0.0
-    return rec, vals
+    return rec, vals, glo
 
 
 def _is_blank(buf, a, b) -> bool:
@@ -178,51 +197,147 @@ def _rinex4_blocks(lines, start, path):
         i = j
 
 
-def read(path, raw: bytes | None = None) -> KeplerConstellation:
+def read(path, raw: bytes | None = None, systems: str | None = None):
     """Parse a RINEX 3.0x/4.00 navigation file (plain or gzip; or its already-read content ``raw``) into a
-    broadcast-ephemeris constellation."""
+    broadcast-ephemeris constellation: a :class:`KeplerConstellation`, or a :class:`CombinedConstellation`
+    (Keplerian part first, GLONASS part last) when GLONASS records are kept. ``systems``: the RINEX letters to
+    keep (default all of G, C, E, J, R)."""
+    systems = ALL_SYSTEMS if systems is None else "".join(c for c in systems if c in ALL_SYSTEMS)
     raw = read_bytes(path) if raw is None else raw
     head_end = raw.find(b"END OF HEADER")
     head_end = len(raw) if head_end < 0 else raw.find(b"\n", head_end) + 1 or len(raw)
     start, version, klob = _header(lines_of(raw[:head_end]) + [""], path)
-    ids, vals, delays = [], [], []
-    if version < 4.0:
-        buf = np.frombuffer(raw, np.uint8)
-        nl = np.flatnonzero(buf == 10)
-        n_lines = nl.size + (1 if buf.size and buf[-1] != 10 else 0)
-        rec, values = _rinex3_records(buf, nl, start, n_lines, path)
-        line_start = np.concatenate(([0], nl + 1))
-        heads = [raw[a:a + 23].decode("latin-1") for a in line_start[rec]]
-        ids = [_sat_id(h[:3]) for h in heads]
-        toc = np.array([_epoch_seconds(h[4:23], path, i + 1) for h, i in zip(heads, rec)])
-        vals = np.column_stack([values, toc]) if rec.size else []
-    else:
-        lines = lines_of(raw)
-        for ln, head, block in _rinex4_blocks(lines, start, path):
-            parts = head[1:].split()
-            if len(parts) < 3:
-                raise DataFileError(path, "record header should read '> TYPE SAT MESSAGE'", ln)
-            rtype, sat, msg = parts[0], parts[1], parts[2]
-            if sat[0] not in "GC":
-                continue
-            if rtype == "ION" and sat[0] not in klob and (msg, sat[0]) in (("LNAV", "G"), ("D1D2", "C")):
-                klob[sat[0]] = _ion4(block, path, ln + 1)
-            elif rtype == "EPH" and msg in ("LNAV", "D1", "D2"):
-                _check_len(block, ln + 1, path)
-                ids.append(_sat_id(block[0][:3]))
-                vals.append(np.append(_values(block, path, ln + 1),
-                                      _epoch_seconds(block[0][4:23], path, ln + 1)))
-            elif rtype == "EPH" and msg in _CNV_DELAYS and sat[0] == "C":
-                if len(block) < 8:
-                    raise DataFileError(path, f"{msg} record is truncated", ln + len(block))
-                row = [number(block[7][4 + 19 * k: 23 + 19 * k], path, ln + 8, "group delay", blank=np.nan)
-                       for k in range(4)]
-                t = _epoch_seconds(block[0][4:23], path, ln + 1)
-                delays.extend((name, _sat_id(block[0][:3]), t, row[f - 24])
-                              for f, name in _CNV_DELAYS[msg].items())
+    body = _rinex3_body if version < 4.0 else _rinex4_body
+    ids, vals, delays, fnav, glo = body(raw, start, path, systems, klob)
+    offsets = klob.pop("_sto", {})
+    const = _assemble(path, klob, ids, vals, delays, fnav, glo, systems)
+    const.time_offsets = offsets
+    return const
+
+
+def _assemble(path, klob, ids, vals, delays, fnav, glo, systems):
+    """The constellation object from the parsed records: Keplerian, GLONASS, or both combined."""
+    if not ids and not glo:
+        wanted = ", ".join(SYSTEM_NAMES[c] for c in systems)
+        raise DataFileError(path, f"no broadcast ephemeris records found for {wanted or 'any system'}")
+    if not glo:
+        return build(ids, np.array(vals), str(path), klob, delays, path, np.array(fnav, bool))
+    glo_ids = [g[0] for g in glo]
+    glo_t = np.array([g[1] for g in glo])
+    ref_week = int(np.floor(glo_t.min() / SECONDS_PER_WEEK))
+    if ids:
+        kep = build(ids, np.array(vals), str(path), klob, delays, path, np.array(fnav, bool))
+        ref_week = kep.ref_week
+    glo_c = _build_glonass(glo_ids, glo_t, np.array([g[2] for g in glo]), np.array([g[3] for g in glo]),
+                           np.array([g[4] for g in glo]), ref_week, str(path), path)
     if not ids:
-        raise DataFileError(path, "no GPS or BDS broadcast ephemeris records found")
-    return build(ids, np.array(vals), str(path), klob, delays, path)
+        return glo_c
+    return CombinedConstellation([kep, glo_c], str(path))
+
+
+def _rinex3_body(raw, start, path, systems, klob):
+    """RINEX 3 records -> (ids, values + toc rows, CNAV delays (none), F/NAV flags, GLONASS records)."""
+    buf = np.frombuffer(raw, np.uint8)
+    nl = np.flatnonzero(buf == 10)
+    n_lines = nl.size + (1 if buf.size and buf[-1] != 10 else 0)
+    rec, values, glo_rec = _rinex3_records(buf, nl, start, n_lines, path, systems)
+    line_start = np.concatenate(([0], nl + 1))
+    heads = [raw[a:a + 23].decode("latin-1") for a in line_start[rec]]
+    ids = [_sat_id(h[:3]) for h in heads]
+    toc = np.array([_epoch_seconds(h[4:23], path, i + 1) for h, i in zip(heads, rec)])
+    vals = np.column_stack([values, toc]) if rec.size else []
+    fnav = [id_[0] == "E" and int(v[CODES]) & 2 != 0 for id_, v in zip(ids, values)]
+    glo = []
+    if glo_rec.size:
+        text = lines_of(raw)
+        glo = [_glonass_record(text[i:i + 4], path, i + 1) for i in glo_rec]
+    return ids, vals, [], fnav, glo
+
+
+def _rinex4_body(raw, start, path, systems, klob):
+    """RINEX 4 records -> (ids, values + toc rows, BDS CNAV group delays, F/NAV flags, GLONASS records); the
+    first ION record of GPS LNAV / BDS D1D2 fills ``klob``."""
+    ids, vals, delays, fnav, glo = [], [], [], [], []
+    for ln, head, block in _rinex4_blocks(lines_of(raw), start, path):
+        parts = head[1:].split()
+        if len(parts) < 3:
+            raise DataFileError(path, "record header should read '> TYPE SAT MESSAGE'", ln)
+        rtype, sat, msg = parts[0], parts[1], parts[2]
+        if sat[0] not in systems:
+            continue
+        if rtype == "ION" and sat[0] not in klob and (msg, sat[0]) in (("LNAV", "G"), ("D1D2", "C")):
+            klob[sat[0]] = _ion4(block, path, ln + 1)
+        elif rtype == "STO" and len(block) >= 2:
+            kind = block[0][24:28]
+            week, sow = gpstime.normalize(0, _epoch_seconds(block[0][4:23], path, ln + 1))
+            klob.setdefault("_sto", {}).setdefault(kind, TimeOffset(
+                kind, number(block[1][23:42], path, ln + 2, "a0"), number(block[1][42:61], path, ln + 2, "a1"),
+                (int(week), float(sow))))
+        elif rtype == "EPH" and (sat[0], msg) in _KEPLER_MESSAGES:
+            _check_len(block, ln + 1, path)
+            ids.append(_sat_id(block[0][:3]))
+            fnav.append(msg == "FNAV")
+            vals.append(np.append(_values(block, path, ln + 1), _epoch_seconds(block[0][4:23], path, ln + 1)))
+        elif rtype == "EPH" and sat[0] == "R" and msg == "FDMA":
+            if len(block) < 4:
+                raise DataFileError(path, f"FDMA record for {sat} has {len(block)} lines, expected 5",
+                                    ln + len(block))
+            glo.append(_glonass_record(block[:4], path, ln + 1))
+        elif rtype == "EPH" and msg in _CNV_DELAYS and sat[0] == "C":
+            if len(block) < 8:
+                raise DataFileError(path, f"{msg} record is truncated", ln + len(block))
+            row = [number(block[7][4 + 19 * k: 23 + 19 * k], path, ln + 8, "group delay", blank=np.nan)
+                   for k in range(4)]
+            t = _epoch_seconds(block[0][4:23], path, ln + 1)
+            delays.extend((name, _sat_id(block[0][:3]), t, row[f - 24]) for f, name in _CNV_DELAYS[msg].items())
+    return ids, vals, delays, fnav, glo
+
+
+SYSTEM_NAMES = {"G": "GPS", "C": "BDS", "E": "Galileo", "J": "QZSS", "R": "GLONASS"}
+_KEPLER_MESSAGES = {("G", "LNAV"), ("C", "D1"), ("C", "D2"), ("E", "INAV"), ("E", "FNAV"), ("J", "LNAV")}
+
+
+def _glonass_record(block, path, ln):
+    """One GLONASS record (RINEX 3 or 4, first 4 lines) -> (sat id, tb GPS seconds since 1980, (9,) position,
+    velocity and acceleration m, m/s, m/s^2 + (-tau_n -> tau_n, gamma_n) as (11,), health, channel)."""
+    head = block[0]
+    for j, line in enumerate(block[1:4]):
+        if line[:4].strip():
+            raise DataFileError(path, "GLONASS record is truncated: expected a broadcast-orbit line", ln + 1 + j)
+    minus_tau = number(head[23:42], path, ln, "-TauN", blank=None)
+    gamma = number(head[42:61], path, ln, "GammaN", blank=None)
+    orbit = np.array([[number(block[1 + a][4 + 19 * k: 23 + 19 * k], path, ln + 1 + a,
+                              f"GLONASS orbit value {4 * a + k + 1}", blank=None if k < 2 else 0.0)
+                       for k in range(4)] for a in range(3)])  # rows x, y, z; columns pos km, vel, acc, extra
+    channel = int(orbit[1, 3])
+    if channel not in glonass.FREQ_CHANNELS:
+        raise DataFileError(path, f"GLONASS frequency number {channel}: expected -7..13", ln + 2)
+    utc_s = _epoch_seconds(head[4:23], path, ln)
+    tb = utc_s + _leap_seconds_at(utc_s)
+    state = np.concatenate([orbit[:, 0], orbit[:, 1], orbit[:, 2]]) * 1e3
+    return _sat_id(head[:3]), tb, np.concatenate([state, [-minus_tau, gamma]]), orbit[0, 3] == 0, channel
+
+
+def _leap_seconds_at(utc_seconds: float) -> float:
+    """GPST - UTC (s) at UTC seconds since 1980-01-06 (skyfield's table)."""
+    when = gpstime.GPS_EPOCH + timedelta(seconds=float(utc_seconds))
+    return gpstime.leap_seconds(when) + gpstime.GPS_MINUS_TAI
+
+
+def _build_glonass(ids, tb, values, healthy, channel, ref_week, source, path):
+    sat_ids = sorted(set(ids))
+    sat = np.searchsorted(sat_ids, ids)
+    for s in range(len(sat_ids)):
+        ks = np.unique(channel[sat == s])
+        if ks.size > 1:
+            raise DataFileError(path, f"{sat_ids[s]}: records give different frequency numbers "
+                                f"{', '.join(map(str, ks))}")
+    p = np.zeros((len(ids), glonass.N_COLS))
+    p[:, glonass.TB] = tb - ref_week * SECONDS_PER_WEEK
+    p[:, 1:10] = values[:, :9]
+    p[:, glonass.TAUN], p[:, glonass.GAMN] = values[:, 9], values[:, 10]
+    return glonass.GlonassConstellation(sat_ids, glonass.GlonassRecords(p, sat, healthy, channel), source,
+                                        ref_week)
 
 
 def _check_len(block, ln, path):
@@ -243,14 +358,22 @@ def _ion4(block, path, ln) -> Klobuchar:
     return Klobuchar(np.array(vals[:4]), np.array(vals[4:8]))
 
 
-def build(ids, vals, source, klob, cnav_delays, path) -> KeplerConstellation:
-    """Records (one row of 31 RINEX values + toc calendar seconds per record) -> KeplerConstellation."""
+def build(ids, vals, source, klob, cnav_delays, path, fnav=None) -> KeplerConstellation:
+    """Records (one row of 31 RINEX values + toc calendar seconds per record) -> KeplerConstellation.
+
+    ``fnav`` (R,) bool marks Galileo F/NAV records: they are kept in the table but used for a satellite's states
+    only when it has no I/NAV record."""
     ids = np.array(ids)
     sat_ids = sorted(set(ids.tolist()))
     sat = np.searchsorted(sat_ids, ids)
-    is_bds = np.char.startswith(ids, "C")
-    offs = np.where(is_bds, SYSTEMS["C"].time_offset_s, 0.0)
-    week_off = np.where(is_bds, SYSTEMS["C"].week_offset, 0)
+    letter = ids.astype("<U1")
+    is_bds = letter == "C"
+    offs = np.zeros(len(ids))
+    week_off = np.zeros(len(ids), dtype=np.int64)
+    half = np.zeros(len(ids))
+    for code, system in SYSTEMS.items():
+        m = letter == code
+        offs[m], week_off[m], half[m] = system.time_offset_s, system.week_offset, system.fit_half_s
     toc_abs = vals[:, N_FIELDS] + offs
     toe_abs = (vals[:, WEEK] + week_off) * SECONDS_PER_WEEK + vals[:, TOE] + offs
     toe_abs += SECONDS_PER_WEEK * np.round((toc_abs - toe_abs) / SECONDS_PER_WEEK)
@@ -267,7 +390,7 @@ def build(ids, vals, source, klob, cnav_delays, path) -> KeplerConstellation:
                     ("af2", AF2), ("toe_sow", TOE)):
         p[:, c[name]] = vals[:, f]
     for code, system in SYSTEMS.items():
-        m = ids.astype("<U1") == code
+        m = letter == code
         p[m, c["mu"]] = system.mu
         p[m, c["omega_e"]] = system.omega_e
         p[m, c["rel_f"]] = system.rel_f
@@ -276,10 +399,16 @@ def build(ids, vals, source, klob, cnav_delays, path) -> KeplerConstellation:
         k = int(np.flatnonzero(bad)[0])
         raise DataFileError(path, f"record {k + 1} ({ids[k]}): sqrt(A) must be > 0 and 0 <= e < 1")
     p[:, c["geo"]] = is_bds & (vals[:, SQRTA] ** 2 > GEO_MIN_A_M) & (np.abs(vals[:, I0]) < GEO_MAX_INC_RAD)
-    half = np.where(is_bds, SYSTEMS["C"].fit_half_s, SYSTEMS["G"].fit_half_s)
-    records = Records(p, sat, vals[:, HEALTH] == 0, half)
+    use = vals[:, HEALTH] == 0
+    if fnav is not None and fnav.any():
+        has_inav = np.zeros(len(sat_ids), bool)
+        has_inav[sat[~fnav & (letter == "E")]] = True
+        use &= ~(fnav & has_inav[sat])
+    records = Records(p, sat, use, half, after_toe=letter == "E")
     delays = {}
-    for name, f, m in (("TGD", TGD1, ~is_bds), ("TGD1", TGD1, is_bds), ("TGD2", TGD2, is_bds)):
+    is_gal = letter == "E"
+    for name, f, m in (("TGD", TGD1, (letter == "G") | (letter == "J")), ("TGD1", TGD1, is_bds),
+                       ("TGD2", TGD2, is_bds), ("BGD_E5a", TGD1, is_gal & use), ("BGD_E5b", TGD2, is_gal & use)):
         if m.any():
             delays[name] = GroupDelays(sat[m], p[m, c["toe"]], vals[m, f])
     for name in sorted({d[0] for d in cnav_delays}):

@@ -23,6 +23,12 @@ class Sky:
         self.duplicates = sorted({s for s in self.sat_ids if s in seen or seen.add(s)})
 
     @property
+    def channels(self) -> np.ndarray:
+        """(S,) int GLONASS FDMA frequency numbers (0 for CDMA satellites)."""
+        return np.concatenate([c.channels for c in self.constellations]) if self.constellations else \
+            np.zeros(0, np.int64)
+
+    @property
     def sources(self) -> list[str]:
         return [c.source for c in self.constellations]
 
@@ -54,6 +60,7 @@ class Sky:
         return out
 
 
-def load_sky(sources) -> Sky:
-    """A :class:`Sky` of the constellations loaded from ``sources`` (see :func:`load`), in order."""
-    return Sky([load(s) for s in sources])
+def load_sky(sources, systems: str | None = None) -> Sky:
+    """A :class:`Sky` of the constellations loaded from ``sources`` (see :func:`load`), in order; ``systems``
+    (RINEX navigation sources only) the system letters to keep (default all)."""
+    return Sky([load(s, systems=systems) for s in sources])

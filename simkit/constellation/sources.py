@@ -29,15 +29,19 @@ def resolve(source) -> Path:
                         f"(bundled: {', '.join(bundled_files()) or 'none'}; or nominal:gps / nominal:bds)")
 
 
-def load(source, *, validity_days: float | None = None) -> Constellation:
+def load(source, *, validity_days: float | None = None, systems: str | None = None) -> Constellation:
     """Load a constellation.
 
     ``source``: ``nominal:gps``, ``nominal:bds`` (= ``nominal:bds3``), ``nominal:bds2``, ``nominal:bds3``,
-    ``nominal:gps+bds``; a file path; a bundled file name; or ``almanac:<RINEX nav source>`` (an almanac derived
+    ``nominal:gps+bds``, ``nominal:gal``, ``nominal:glo``, ``nominal:gps+bds+gal+glo``; a file path; a bundled
+    file name; or ``almanac:<RINEX nav source>`` (an almanac derived
     from the broadcast records nearest the middle of the file, see :func:`almanac.from_ephemeris`). Files: RINEX 3.0x/4.00 navigation (plain or .gz),
     YUMA or SEM GPS almanacs, TLE sets (2- or 3-line). ``validity_days`` (almanac and TLE sources only) is the
     span either side of the almanac/TLE epoch in which states are returned (default 7 days); broadcast
-    ephemerides always use their fit interval (GPS +-2 h, BDS +-1 h).
+    ephemerides always use their fit interval (GPS, QZSS +-2 h, BDS +-1 h, GLONASS +-30 min; Galileo the latest
+    record before t, for 4 h).
+    ``systems`` (RINEX navigation files only): the system letters to keep, e.g. ``"GC"`` (default: all of
+    G, C, E, J, R in the file).
     """
     text = str(source)
     if text.startswith("almanac:"):
@@ -59,7 +63,7 @@ def load(source, *, validity_days: float | None = None) -> Constellation:
 
     raw = read_bytes(path)
     if rinex_nav.is_rinex_nav(lines_of(raw[:200])):
-        return rinex_nav.read(path, raw)
+        return rinex_nav.read(path, raw, systems)
     lines = lines_of(raw)
     kw = {} if validity_days is None else {"validity_days": validity_days}
     if almanac.is_yuma(lines):

@@ -50,9 +50,9 @@ def spp_fixes(ds, p):
         c, d = g.obs["code"][sig], g.obs["doppler"][sig]
         if code is None:
             code, doppler = c.copy(), d.copy()
-            wl, gd = np.full(c.shape[1], g.wavelength_m[j]), g.group_delay[:, j].copy()
+            wl, gd = g.sat_wavelength_m[:, j].copy(), g.group_delay[:, j].copy()  # per satellite: FDMA
         take = np.isnan(code).all(0) & ~np.isnan(c).all(0)
-        code[:, take], doppler[:, take], wl[take], gd[take] = c[:, take], d[:, take], g.wavelength_m[j], \
+        code[:, take], doppler[:, take], wl[take], gd[take] = c[:, take], d[:, take], g.sat_wavelength_m[take, j], \
             g.group_delay[take, j]
     if p["ionosphere"] == "iono-free":
         code, gd, iono, why = ionosphere_free(g)

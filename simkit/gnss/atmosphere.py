@@ -109,9 +109,17 @@ def broadcast_ionosphere(system: str, alpha, beta, lat, lon, az, el, gps_tow):
     raise ValueError(f"system: {system!r} has no broadcast Klobuchar model; expected 'G' or 'C'")
 
 
+def model_system(system: str) -> str:
+    """Which broadcast Klobuchar model the delays of ``system`` come from: 'C' (BDS model) for BDS, else 'G'.
+
+    Galileo's NeQuick G is not implemented: Galileo, QZSS and GLONASS take the GPS model and coefficients,
+    scaled by frequency, so every system sees the same ionosphere along a line of sight."""
+    return "C" if system == "C" else "G"
+
+
 def reference_frequency(system: str) -> float:
-    """Frequency (Hz) the broadcast model of ``system`` refers to: L1 for 'G', B1I for 'C'."""
-    return F_L1 if system == "G" else F_B1I
+    """Frequency (Hz) the broadcast model used for ``system`` refers to: B1I for 'C', L1 for the others."""
+    return F_B1I if system == "C" else F_L1
 
 
 def ionosphere(system: str, alpha, beta, lla, vel_enu, az, el, az_rate, el_rate, gps_tow, h: float = 0.05):

@@ -84,6 +84,14 @@ class GnssConfig:
     iono_coefficients: dict[str, tuple] = field(default_factory=dict)  # "gps"/"bds" -> (alpha, beta) overrides
     code_error_scale: dict[str, float] = field(default_factory=dict)  # signal -> factor on code noise + multipath
 
+    @property
+    def nav_systems(self) -> str:
+        """System letters to read from RINEX navigation sources: GPS and BDS always (as before Galileo, GLONASS
+        and QZSS existed, so GPS/BDS scenarios keep their satellites), plus each system with a configured
+        signal."""
+        wanted = {"G", "C"} | {signals.SIGNALS[n].system for n in self.signals}
+        return "".join(c for c in "GCEJR" if c in wanted)
+
 
 def _unit(v, key_section: Section, name: str) -> np.ndarray:
     v = np.asarray(v, dtype=float)

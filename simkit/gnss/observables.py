@@ -20,6 +20,7 @@ class GnssStatic:
     signals: np.ndarray
     frequency_hz: np.ndarray
     wavelength_m: np.ndarray
+    sat_frequency_hz: np.ndarray   # (S, G) Hz: per satellite (GLONASS FDMA channels), else frequency_hz
     group_delay: np.ndarray
     lever_arm_b: np.ndarray
     boresight_b: np.ndarray

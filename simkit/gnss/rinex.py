@@ -71,7 +71,29 @@ def marker_type(antenna_pos_ecef) -> str:
     return "AIRBORNE" if np.ptp(h) > 30.0 else "GROUND_CRAFT"
 
 
-def _header(systems, types, first, first_frac, approx_pos_ecef, marker, interval_s, kind) -> str:
+def glonass_slot_lines(channels: dict) -> str:
+    """RINEX 3.04 'GLONASS SLOT / FRQ #' header lines for {"R01": k, ...} (8 satellites a line)."""
+    items = sorted(channels.items())
+    out = ""
+    for i in range(0, len(items), 8):
+        head = f"{len(items):3d} " if i == 0 else " " * 4
+        out += _hdr(head + "".join(f"{sat} {k:2d} " for sat, k in items[i:i + 8]), "GLONASS SLOT / FRQ #")
+    return out
+
+
+def channels_from_frequencies(sat_ids, signal_names, sat_frequency_hz) -> dict:
+    """{GLONASS sat id: FDMA channel k} from /gnss/sat_frequency_hz (S, G) and the signal names (G,)."""
+    out = {}
+    for j, name in enumerate(signal_names):
+        g = sigmod.get(name)
+        if g.is_fdma:
+            for s, sat in enumerate(sat_ids):
+                if sat[0] == g.system:
+                    out[sat] = int(round((float(sat_frequency_hz[s, j]) - g.freq_hz) / g.fdma_step_hz))
+    return out
+
+
+def _header(systems, types, first, first_frac, approx_pos_ecef, marker, interval_s, kind, channels=None) -> str:
     """The RINEX 3.04 observation header."""
     mixed = "M" if len(types) > 1 else next(iter(types), "G")
     now = datetime.now(timezone.utc).strftime("%Y%m%d %H%M%S UTC")
@@ -97,19 +119,23 @@ def _header(systems, types, first, first_frac, approx_pos_ecef, marker, interval
         for code in types.get(sys, []):
             if code[0] == "L":
                 head += _hdr(f"{sys} {code} {0.0:8.5f}", "SYS / PHASE SHIFT")
+    if "R" in types:
+        head += glonass_slot_lines(channels or {})
+        # simulated receivers have no GLONASS code-phase bias (RINEX 3.04 sec. 5.12: required with GLONASS)
+        head += _hdr(" C1C    0.000 C1P    0.000 C2C    0.000 C2P    0.000", "GLONASS COD/PHS/BIS")
     head += _hdr("", "END OF HEADER")
     return head
 
 
 def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, approx_pos_ecef,
               clock_bias_s=None, marker: str = "SIMKIT", interval_s: float | None = None,
-              kind: str = "GEODETIC") -> Path:
+              kind: str = "GEODETIC", glonass_channels: dict | None = None) -> Path:
     """Write one antenna's observations as a RINEX 3.04 observation file.
 
     ``t`` (M,) s since (start_week, start_sow); ``obs``: signal name -> dict with "code", "carrier", "doppler",
     "cn0" (M, S) float and "lli" (M, S) uint8 for this antenna; ``clock_bias_s`` (M,) receiver clock bias added
-    to the time tags (None: true GPS time); ``kind`` the MARKER TYPE. Written under a temporary name and
-    renamed when complete. Returns the path.
+    to the time tags (None: true GPS time); ``kind`` the MARKER TYPE; ``glonass_channels`` {"R01": k} for the
+    'GLONASS SLOT / FRQ #' header. Written under a temporary name and renamed when complete. Returns the path.
     """
     path = Path(path)
     t = np.asarray(t, dtype=float)
@@ -118,7 +144,7 @@ def write_obs(path, start_week: int, start_sow: float, t, sat_ids, obs: dict, ap
     types = _obs_types(obs.keys(), systems)
     tag = t if clock_bias_s is None else t + np.asarray(clock_bias_s, dtype=float)
     first, first_frac = _calendar(*gpstime.add_seconds(start_week, start_sow, float(tag[0])))
-    head = _header(systems, types, first, first_frac, approx_pos_ecef, marker, interval_s, kind)
+    head = _header(systems, types, first, first_frac, approx_pos_ecef, marker, interval_s, kind, glonass_channels)
 
     # per system: which (signal, field) feeds each obs-type column
     columns = {}
@@ -195,12 +221,16 @@ def export(gnss, start_week: int, start_sow: float, out_dir, nav_sources=(), nam
     track = np.asarray(gnss["truth/antenna_pos_ecef"][...], dtype=float)
     ant_pos = track[0]
     interval = float(np.median(np.diff(t))) if t.size > 1 else None
+    channels = {}
+    if "sat_frequency_hz" in gnss and "signals" in gnss:
+        names = [s.decode() if isinstance(s, bytes) else str(s) for s in np.asarray(gnss["signals"][...])]
+        channels = channels_from_frequencies(sat_ids, names, np.asarray(gnss["sat_frequency_hz"][...]))
     paths = []
     for a in range(ant_pos.shape[0]):
         obs = {n: {f: np.asarray(gnss[f"obs/{n}/{f}"][:, a, :]) for f in ("code", "carrier", "doppler", "cn0", "lli")}
                for n in sig_names}
         paths.append(write_obs(out_dir / f"{name}_ant{a}.rnx", start_week, start_sow, t, sat_ids, obs,
                                ant_pos[a], clock[:, a], marker=f"{name.upper()}_ANT{a}", interval_s=interval,
-                               kind=marker_type(track[:, a])))
+                               kind=marker_type(track[:, a]), glonass_channels=channels))
     files = [resolve(s) for s in nav_sources if not str(s).startswith("nominal:")]
     return paths + copy_nav(files, out_dir)

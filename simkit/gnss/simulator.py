@@ -32,11 +32,14 @@ from .multipath import elevation_scale, multipath_bank
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
 
-_GD_NAMES = {"tgd": ("TGD",), "tgd1": ("TGD1",), "tgd2": ("TGD2",)}
+_GD_NAMES = {"tgd": ("TGD",), "tgd1": ("TGD1",), "tgd2": ("TGD2",), "bgd_e5a": ("BGD_E5a",),
+             "bgd_e5b": ("BGD_E5b",)}
 _GD_PREFERRED = {"B1C": ("TGD_B1Cp",), "B2a": ("TGD_B2ap",)}
 _MASK_MARGIN_RAD = 1e-3  # satellites this close below the mask at the IMU centre may be up at an antenna
 _DEFAULT_KLOBUCHAR = {"G": (atmosphere.DEFAULT_GPS_ALPHA, atmosphere.DEFAULT_GPS_BETA),
                       "C": (atmosphere.DEFAULT_BDS_ALPHA, atmosphere.DEFAULT_BDS_BETA)}
+# the broadcast ionosphere model each system's delays come from: Galileo, QZSS and GLONASS use the GPS
+# Klobuchar model and coefficients, scaled from L1 to each carrier (one ionosphere for every line of sight)
 
 
 class GnssSimulator:
@@ -62,6 +65,11 @@ class GnssSimulator:
         self.boresight = np.array([a.boresight_b for a in cfg.antennas])
         overrides = {"G": cfg.iono_coefficients.get("gps"), "C": cfg.iono_coefficients.get("bds")}
         self.iono = {k: overrides[k] or sky.klobuchar(k) or _DEFAULT_KLOBUCHAR[k] for k in "GC"}
+        self.iono_model = np.array([atmosphere.model_system(x) for x in self.system], dtype="U1")
+        # carrier frequency (S, G) Hz per satellite and signal: per FDMA channel for GLONASS
+        channels = sky.channels
+        self.freq = np.array([[g.frequency_for(channels[s]) if g.is_fdma else g.freq_hz for g in self.signals]
+                              for s in range(len(self.sat_ids))], dtype=float).reshape(len(self.sat_ids), -1)
         self.group_delay_s = self._group_delays()
         n_clk = self.n_ant if cfg.clock_mode == "per_antenna" else 1
         self.clocks = [ClockProcess(cfg.oscillator, self.dt, rng.generator(seed, "gnss", "clock",
@@ -101,12 +109,13 @@ class GnssSimulator:
         return GnssStatic(sat_id=np.array(self.sat_ids), signals=np.array(self.cfg.signals),
                           frequency_hz=np.array([g.freq_hz for g in self.signals]),
                           wavelength_m=np.array([g.wavelength_m for g in self.signals]),
+                          sat_frequency_hz=self.freq,
                           group_delay=self.group_delay_s * C_LIGHT * self.cfg.errors["group_delay"],
                           lever_arm_b=self.lever, boresight_b=self.boresight, **self._klobuchar_rows())
 
     def _klobuchar_rows(self) -> dict[str, np.ndarray]:
         """The broadcast Klobuchar coefficients used, one row per simulated system with a model (G, C)."""
-        systems = [k for k in self.iono if k in set(self.system)]
+        systems = [k for k in self.iono if k in set(self.iono_model)]
         return {"iono_systems": np.array(systems, dtype="U1"),
                 "iono_alpha": np.array([self.iono[k][0] for k in systems], dtype=float).reshape(-1, 4),
                 "iono_beta": np.array([self.iono[k][1] for k in systems], dtype=float).reshape(-1, 4)}
@@ -169,15 +178,17 @@ class GnssSimulator:
             bias, drift = np.repeat(bias, self.n_ant, axis=1), np.repeat(drift, self.n_ant, axis=1)
         return bias, drift
 
-    def sigmas(self, cn0, g):
-        """Thermal-noise standard deviations (code m, carrier m, Doppler Hz) at C/N0 ``cn0`` dB-Hz."""
+    def sigmas(self, cn0, g, wavelength_m=None):
+        """Thermal-noise standard deviations (code m, carrier m, Doppler Hz) at C/N0 ``cn0`` dB-Hz (carrier
+        wavelength ``wavelength_m``, broadcastable to ``cn0``; default the signal's)."""
+        lam = g.wavelength_m if wavelength_m is None else wavelength_m
         nz = self.cfg.noise
         if nz.model == "constant":
             one = np.ones_like(cn0)
             return one * nz.code_sigma_m, one * nz.carrier_sigma_m, one * nz.doppler_sigma_hz
         return (noise.dll_sigma_m(cn0, g.chip_length_m, nz.dll_bandwidth_hz, nz.correlator_spacing_chips,
                                   nz.integration_time_s),
-                noise.pll_sigma_m(cn0, g.wavelength_m, nz.pll_bandwidth_hz, nz.integration_time_s),
+                noise.pll_sigma_m(cn0, lam, nz.pll_bandwidth_hz, nz.integration_time_s),
                 noise.fll_sigma_hz(cn0, nz.fll_bandwidth_hz, nz.integration_time_s))
 
 
@@ -238,12 +249,13 @@ class _Parts:
             self.trop = self.trop_rate = np.zeros(self.el.shape)
 
     def _ionosphere(self, err, sow):
-        """Delay (M, A, C) m at each system's reference frequency (L1, B1I) and its rate."""
+        """Delay (M, A, C) m at each model's reference frequency (L1 for GPS, Galileo, QZSS, GLONASS; B1I for
+        BDS) and its rate."""
         self.iono = np.zeros(self.el.shape)
         self.iono_rate = np.zeros(self.el.shape)
         if not err["ionosphere"]:
             return
-        view, system = self.view, self.sim.system[self.cand]
+        view, system = self.view, self.sim.iono_model[self.cand]
         for letter in "GC":
             cols = system == letter
             if cols.any():
@@ -259,10 +271,11 @@ class _Parts:
         cols = self.cand[cj]
         rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
         cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, g.cn0_offset_db)
-        sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g))
-        code_scale = cfg.code_error_scale.get(g.name, 1.0)
-        sig_c = sig_c * code_scale
-        scale = (atmosphere.reference_frequency(g.system) / g.freq_hz) ** 2
+        freq = sim.freq[cols, j]                                                    # (C,) Hz
+        lam = C_LIGHT / freq if g.is_fdma else g.wavelength_m
+        sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g, lam))
+        sig_c = sig_c * cfg.code_error_scale.get(g.name, 1.0)
+        scale = (atmosphere.reference_frequency(g.system) / freq) ** 2
         iono, iono_rate = self.iono[..., cj] * scale, self.iono_rate[..., cj] * scale
         el = self.el[..., cj]
         if self.mp is not None:
@@ -289,8 +302,8 @@ class _Parts:
 
         self.obs[g.name] = SignalObs(
             code=put(base + gd + iono + mp_c + n_c, True),
-            carrier=put((base - iono + mp_p + n_p) / g.wavelength_m + amb[..., cols, j], True),
-            doppler=put(-(rate - iono_rate + (0.0 if mp_rate is None else mp_rate)) / g.wavelength_m + n_d, True),
+            carrier=put((base - iono + mp_p + n_p) / lam + amb[..., cols, j], True),
+            doppler=put(-(rate - iono_rate + (0.0 if mp_rate is None else mp_rate)) / lam + n_d, True),
             cn0=put(cn0, True),
             ambiguity=amb[..., j], lli=lli[..., j])
         self.signal_truth[g.name] = SignalTruth(

@@ -23,7 +23,7 @@ from ..constellation.geometry import angles_from_enu
 from ..earth import C_LIGHT, OMEGA_E
 from ..errors import InputError
 from ..frames import ecef_to_enu_matrix, ecef_to_lla
-from .atmosphere import broadcast_ionosphere, reference_frequency, troposphere
+from .atmosphere import broadcast_ionosphere, model_system, reference_frequency, troposphere
 
 
 class SppInputError(InputError):
@@ -135,7 +135,9 @@ def _iterate(code, sat, sys_onehot, mask_rad, sigma, iterations, delays, first, 
     active = np.arange(m)
     for it in range(first, first + iterations):
         xa = x[active]
-        rho, ea = _geometry(xa[:, :3], sat[active])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rho, ea = _geometry(xa[:, :3], sat[active])
+        ea = np.nan_to_num(ea)  # a satellite without a state (unhealthy) sits at the origin, as the receiver at first
         ela, az, lla = _elevation(xa[:, :3], ea)
         late = it >= 3
         atm = delays.rows(active)(lla, ela, az) if late else 0.0
@@ -166,8 +168,9 @@ def _delays(systems, wavelength_m, iono_coefficients, gps_sow, m) -> _Delays:
     if any(a.shape != (4,) or b.shape != (4,) for a, b in coef.values()):
         raise SppInputError("spp: iono_coefficients: expected {system: (alpha (4,), beta (4,))}")
     freq = C_LIGHT / np.asarray(wavelength_m, float)
-    ref = np.array([reference_frequency(k) if k in coef else np.nan for k in systems])
-    return _Delays(coef, np.nan_to_num((ref / freq) ** 2), np.asarray(gps_sow, float), systems)
+    model = np.array([model_system(k) for k in systems])  # Galileo, QZSS, GLONASS: the GPS model from L1
+    ref = np.array([reference_frequency(k) if k in coef else np.nan for k in model])
+    return _Delays(coef, np.nan_to_num((ref / freq) ** 2), np.asarray(gps_sow, float), model)
 
 
 def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, group_delay_m=None,

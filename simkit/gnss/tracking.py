@@ -12,6 +12,7 @@ import heapq
 import numpy as np
 
 from .. import rng
+from . import signals
 from .config import GnssConfig
 
 LLI_LOSS_OF_LOCK = 1  # RINEX LLI bit 0: lost lock since the previous observation, a cycle slip is possible
@@ -34,9 +35,15 @@ class Tracking:
         self.slip_rate = cfg.slip_rate_per_h / 3600.0 if cfg.errors["cycle_slips"] else 0.0
         self.next_slip = np.full(shape, np.inf)
         if self.slip_rate > 0:
-            for a in range(n_antennas):
-                for s in range(len(sat_ids)):
-                    self.next_slip[a, s] = self.streams[a][s].exponential(1.0 / self.slip_rate, shape[2])
+            # a GPS/BDS satellite draws a first slip time for every GPS/BDS signal (as before other systems
+            # existed: their files stay the same), a Galileo/QZSS/GLONASS satellite for its own signals only, so
+            # adding a system's signals leaves the other satellites' event streams alone
+            sig_sys = np.array([signals.get(n).system for n in cfg.signals])
+            legacy = np.isin(sig_sys, ("G", "C"))
+            for s, sid in enumerate(sat_ids):
+                cols = np.flatnonzero(legacy if sid[0] in "GC" else sig_sys == sid[0])
+                for a in range(n_antennas):
+                    self.next_slip[a, s, cols] = self.streams[a][s].exponential(1.0 / self.slip_rate, cols.size)
         self.t_last = -np.inf
 
     def advance(self, t: np.ndarray, tracked: np.ndarray, reacquire: np.ndarray | None = None):

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import frames, quat
+from ..earth import C_LIGHT
 from ..errors import DataFileError
 
 # group names of :func:`has`, keyed so that callers need not spell HDF5 paths
@@ -167,6 +168,7 @@ class Gnss:
     sat_clock: np.ndarray | None = None
     obs: dict = field(default_factory=dict)
     truth: dict = field(default_factory=dict)
+    sat_wavelength_m: np.ndarray | None = None  # (S, G) m per satellite (GLONASS FDMA); wavelength_m elsewhere
 
 
 def gnss_signals(ds) -> tuple:
@@ -195,10 +197,15 @@ def read_gnss(ds, signals=None, antennas=None, epochs=None, obs=(), truth=(), sa
     a = slice(None) if antennas is None else antennas
     gd = ds["gnss/group_delay"][:][:, cols] if "gnss/group_delay" in ds else None
     sats = (ds["gnss/sat_pos_ecef"][m], ds["gnss/sat_clock"][m]) if satellites else (None, None)
-    return Gnss(ds["gnss/t"][m], ds["gnss/sat_id"][:], names, ds["gnss/wavelength_m"][:][cols], gd,
+    lam = ds["gnss/wavelength_m"][:][cols]
+    n_sat = ds["gnss/sat_id"].shape[0]
+    sat_lam = C_LIGHT / ds["gnss/sat_frequency_hz"][:][:, cols] if "gnss/sat_frequency_hz" in ds else \
+        np.broadcast_to(lam, (n_sat, len(cols))).copy()  # files before FDMA signals: one wavelength per signal
+    return Gnss(ds["gnss/t"][m], ds["gnss/sat_id"][:], names, lam, gd,
                 ds["gnss/antennas/lever_arm_b"][:][a], *sats,
                 obs={k: {s: ds[f"gnss/obs/{s}/{k}"][m, a] for s in names} for k in obs},
-                truth={k: _gnss_truth(ds[f"gnss/truth/{k}"], m, a) for k in truth if f"gnss/truth/{k}" in ds})
+                truth={k: _gnss_truth(ds[f"gnss/truth/{k}"], m, a) for k in truth if f"gnss/truth/{k}" in ds},
+                sat_wavelength_m=sat_lam)
 
 
 def _gnss_truth(array, m, a):

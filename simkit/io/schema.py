@@ -78,10 +78,14 @@ _IMU = [
 ]
 _GNSS = [
     _f("gnss/t", "f8", ("M",), "s", "", "gnss", "receiver epochs since start (true GPS time)"),
-    _f("gnss/sat_id", "str", ("S",), "", "", "gnss", "satellite ids, G01 ... C62"),
+    _f("gnss/sat_id", "str", ("S",), "", "", "gnss",
+       "satellite ids (RINEX 3: G GPS, C BDS, E Galileo, J QZSS, R GLONASS)"),
     _f("gnss/signals", "str", ("G",), "", "", "gnss", "signal names"),
     _f("gnss/frequency_hz", "f8", ("G",), "Hz", "", "gnss", "carrier frequency per signal"),
     _f("gnss/wavelength_m", "f8", ("G",), "m", "", "gnss", "carrier wavelength per signal"),
+    _f("gnss/sat_frequency_hz", "f8", ("S", "G"), "Hz", "", "gnss",
+       "carrier frequency per satellite and signal: frequency_hz, except GLONASS FDMA signals (channel k: "
+       "G1 1602 + 0.5625 k MHz, G2 1246 + 0.4375 k MHz); wavelength = c / this"),
     _f("gnss/group_delay", "f8", ("S", "G"), "m", "", "gnss", "code group delay applied (c TGD-type term)"),
     _f("gnss/iono_systems", "str", ("Y",), "", "", "gnss",
        "systems of the rows of iono_alpha/iono_beta: 'G' (GPS, L1 model) or 'C' (BDS, B1I model)"),
