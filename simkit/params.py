@@ -73,6 +73,9 @@ SCHEMA: dict[str, Param] = {
     "sigma_doppler_m_per_s": Param(float, "Doppler range-rate noise (m/s, 1 sigma)", POS),
     "ionosphere": Param(str, "ionosphere correction of SPP (iono-free: dual-frequency code combination)",
                         choices=("broadcast", "none", "iono-free")),
+    "systems": Param(str, "SPP: the systems used, letters of G, C, E, R, J ('' : every system of the file)",
+                     lambda v: None if set(v) <= set("GCERJ") and len(set(v)) == len(v) else
+                     "expected distinct letters of G, C, E, R, J (e.g. 'GC'), or ''"),
     "truth_pos_sigma_m": Param(float, "gnss=truth: position noise E, N, U (m)", _list_check(NONNEG), shape=3),
     "truth_vel_sigma_m_per_s": Param(float, "gnss=truth: velocity noise (m/s)", POS),
     "seed": Param(int, "seed of the study noise (gnss=truth, attitude_source=truth)", NONNEG),

@@ -35,7 +35,8 @@ def test_kms3_file_has_the_simulated_layout_without_truth(kms3):
     with simkit.open(kms3) as ds:
         assert "truth/t" not in ds
         sigs = [str(s) for s in ds["gnss/signals"][:]]
-        assert sigs == ["L1C", "L2W", "L5Q", "B1I", "B3I", "B1C", "B2a"]
+        assert sigs == ["L1C", "L2W", "L5Q", "B1I", "B3I", "B1C", "B2a", "E1C", "E5aQ", "E5bQ", "E6C", "G1C", "G2C",
+                        "J1C", "J2L", "J5Q"]
         np.testing.assert_array_equal(ds["reference/pos_ecef"][:], KMS3_HEADER_POS)
         assert "RINEX header" in ds.group_attrs("reference")["source"]
         m, s = ds["gnss/t"].shape[0], ds["gnss/sat_id"].shape[0]
@@ -46,9 +47,9 @@ def test_kms3_file_has_the_simulated_layout_without_truth(kms3):
         imported_from = json.loads(ds.attrs["imported_from"])
     assert imported_from["rinex_version"] == 4.0
     parsed = rinex_obs.read(KMS3_OBS)
-    glonass = parsed.systems["R"]
-    assert report["skipped_systems"]["R"] == {"satellites": len(glonass.sats),
-                                              "observations": int(np.isfinite(glonass.values).sum())}
+    sbas = parsed.systems["S"]
+    assert report["skipped_systems"] == {"S": {"satellites": len(sbas.sats),
+                                               "observations": int(np.isfinite(sbas.values).sum())}}
     gps = parsed.systems["G"]
     assert report["skipped_codes"]["G C1W"] == int(np.isfinite(gps.values[..., gps.types.index("C1W")]).sum())
     assert report["observations"]["L1C"]["code"] == int(np.isfinite(gps.values[..., gps.types.index("C1C")]).sum())
@@ -104,9 +105,9 @@ def test_the_given_reference_replaces_the_header(tmp_path):
         assert "user" in ds.group_attrs("reference")["source"]
 
 
-def _solve(path, iono):
+def _solve(path, iono, systems=""):
     assert main(["solve", str(path), "--filter", "spp", "--name", f"spp_{iono.replace('-', '_')}", "-q",
-                 "--set", f'estimator.ionosphere="{iono}"']) == 0
+                 "--set", f'estimator.ionosphere="{iono}"', "--set", f'estimator.systems="{systems}"']) == 0
     with simkit.open(path) as ds:
         name = f"spp_{iono.replace('-', '_')}"
         return ds["gnss/t"][:] + ds.attrs["start_gps_sow"], ds[f"solutions/{name}/pos_ecef"][:]
@@ -118,7 +119,7 @@ def test_spp_on_kms3_agrees_with_rtklib_on_the_same_epochs(kms3, tmp_path):
     and both are a broadcast SPP's 1-3 m from the header position with RMS within 30 % of each other."""
     import pyrtklib as rtk
 
-    t, ours = _solve(kms3, "broadcast")
+    t, ours = _solve(kms3, "broadcast", "GC")
     obs = tmp_path / "kms3_as_305.rnx"
     text = rinex_obs.decompress(KMS3_OBS).decode("latin-1")
     obs.write_text("     3.05" + text[9:], encoding="latin-1")   # RTKLIB 2.4.3 reads no RINEX 4 observations

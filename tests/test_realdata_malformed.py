@@ -152,7 +152,8 @@ def test_navigation_without_a_needed_system(tmp_path):
     with pytest.raises(DataFileError, match="no broadcast ephemeris for the observed systems G .the navigation "
                                             "data has C"):
         importer.import_rinex(gps_only, [_one_system_nav(tmp_path, keep="C")])
-    with pytest.raises(DataFileError, match="no GPS or BDS broadcast ephemeris records"):
+    with pytest.raises(DataFileError, match="no broadcast ephemeris for the observed systems G .the navigation "
+                                            "data has R"):
         importer.import_rinex(gps_only, [_one_system_nav(tmp_path, keep="R")])
     partial = importer.import_rinex(_write(tmp_path), [_one_system_nav(tmp_path, keep="G")])
     assert any("without system(s) C" in n for n in partial.report["notes"])
@@ -226,7 +227,7 @@ def test_navigation_of_another_day_is_one_line(tmp_path):
 
 
 def test_a_file_of_systems_simkit_does_not_know_is_one_line(tmp_path):
-    header = HEADER[:4] + [_h("R    2 C1C L1C", "SYS / # / OBS TYPES")] + HEADER[6:]
-    body = ["> 2016 06 06 11 00 00.0000000  0  1", "R05  21000000.123 7 110355000.456 7"]
-    with pytest.raises(DataFileError, match="no observation of a signal simkit knows .* the file has R: C1C L1C"):
+    header = HEADER[:4] + [_h("S    2 C1C L1C", "SYS / # / OBS TYPES")] + HEADER[6:]
+    body = ["> 2016 06 06 11 00 00.0000000  0  1", "S20  21000000.123 7 110355000.456 7"]
+    with pytest.raises(DataFileError, match="no observation of a signal simkit knows .* the file has S: C1C L1C"):
         importer.import_rinex(_write(tmp_path, header, body))

@@ -89,4 +89,7 @@ def test_signal_mapping_follows_the_signal_table():
     assert rinex_obs.signal_name("C", "C1X", 3.04) is None           # B1C data+pilot: not simkit's B1C (pilot)
     assert rinex_obs.signal_name("C", "L1P", 4.00) == "B1C"
     assert rinex_obs.signal_name("C", "C6I", 3.04) == "B3I"
-    assert rinex_obs.signal_name("R", "C1C", 3.04) is None
+    assert rinex_obs.signal_name("R", "C1C", 3.04) == "G1C"          # GLONASS G1 C/A (FDMA)
+    assert rinex_obs.signal_name("E", "C5Q", 3.04) == "E5aQ"
+    assert rinex_obs.signal_name("J", "C1C", 3.04) == "J1C"          # QZSS L1 C/A: its own name
+    assert rinex_obs.signal_name("S", "C1C", 3.04) is None           # SBAS: not simulated

@@ -43,7 +43,8 @@ def broadcast_ionosphere(ds, p):
 
 def spp_fixes(ds, p):
     """Single-point fixes of antenna ``p['antenna']`` from /gnss/obs (first tracked signal per satellite, or the
-    ionosphere-free combination of its first two signals with ``p['ionosphere'] = 'iono-free'``)."""
+    ionosphere-free combination of its first two signals with ``p['ionosphere'] = 'iono-free'``) of the systems
+    ``p['systems']`` (every system of the file when empty)."""
     g = read_gnss(ds, antennas=antenna(ds, p), obs=("code", "doppler"))
     code = doppler = None
     for j, sig in enumerate(g.signals):
@@ -58,6 +59,8 @@ def spp_fixes(ds, p):
         code, gd, iono, why = ionosphere_free(g)
     else:
         iono, why = broadcast_ionosphere(ds, p)
+    if p["systems"]:
+        code = np.where(np.isin(systems_of(g.sat_id), list(p["systems"]))[None, :], code, np.nan)
     fx = spp(g.t, code, doppler, wl, g.sat_pos_ecef, g.sat_clock, systems_of(g.sat_id), gd,
              p["elevation_mask_deg"], p["sigma_code_m"], p["sigma_doppler_m_per_s"], iono_coefficients=iono,
              gps_sow=float(ds.attrs["start_gps_sow"]) + g.t)

@@ -274,7 +274,8 @@ class _Parts:
         freq = sim.freq[cols, j]                                                    # (C,) Hz
         lam = C_LIGHT / freq if g.is_fdma else g.wavelength_m
         sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g, lam))
-        sig_c = sig_c * cfg.code_error_scale.get(g.name, 1.0)
+        code_scale = cfg.code_error_scale.get(g.name, 1.0)
+        sig_c = sig_c * code_scale
         scale = (atmosphere.reference_frequency(g.system) / freq) ** 2
         iono, iono_rate = self.iono[..., cj] * scale, self.iono_rate[..., cj] * scale
         el = self.el[..., cj]

@@ -98,6 +98,7 @@ def _solve(a, y, w, mask):
     y = np.where(mask, y, 0.0)
     aw = a * np.where(mask, w, 0.0)[..., None]
     n = np.swapaxes(aw, 1, 2) @ a
+    n = n + np.einsum("mi,ij->mij", (np.einsum("mii->mi", n) == 0.0) * 1.0, np.eye(a.shape[-1]))  # a clock unseen
     eig = np.linalg.eigvalsh(n)
     ok = eig[:, 0] > 1e-12 * eig[:, -1]
     n[~ok] = np.eye(a.shape[-1])
@@ -114,7 +115,7 @@ def _position(code, sat, sys_onehot, mask_rad, sigma, iterations, delays):
     coarse = np.arange(0, m, COARSE)
     xc, _, _, used, _, ok = _iterate(code[coarse], sat[coarse], sys_onehot, mask_rad, sigma, iterations,
                                      delays.rows(coarse), 0)
-    good = np.flatnonzero(ok & (used.sum(1) >= 3 + sys_onehot.shape[1]))
+    good = np.flatnonzero(ok & (used.sum(1) >= 3 + (sys_onehot[None] * used[..., None]).any(1).sum(1)))
     x0 = np.zeros((m, xc.shape[1]))
     if good.size:
         nearest = np.clip(np.searchsorted(coarse[good], np.arange(m) - COARSE // 2), 0, good.size - 1)
