@@ -6,9 +6,10 @@ given row by row per latitude (``LAT/LON1/LON2/DLON/H``, then the longitudes in 
 10^EXPONENT TECU, 9999 where no value is available. Epochs are UT; they are turned into GPS time with the leap
 seconds of the first map. RMS and height maps are skipped.
 
-Interpolation follows the format description's simplest scheme: bilinear in latitude and longitude inside a map,
-linear in time between consecutive maps (no rotation of the maps with the Sun). A point outside the grid's
-latitudes or between maps with a missing value is NaN.
+Interpolation is the format description's recommended scheme (its eq. 3, as RTKLIB's ``iontec``): linear in time
+between the consecutive maps i, i+1, each read at the longitude rotated with the Sun, lon + (t - T_i) 360 deg/day,
+and bilinear in latitude and longitude inside a map. A point outside the grid's latitudes or next to a missing value
+is NaN.
 """
 from __future__ import annotations
 
@@ -51,30 +52,31 @@ class IonexMaps:
         lat = np.degrees(np.asarray(lat_rad, dtype=float))
         lon = np.degrees(np.asarray(lon_rad, dtype=float))
         dt, lat, lon = np.broadcast_arrays(dt, lat, lon)
-        span = self.lon_deg[-1] - self.lon_deg[0]
-        if span >= 360.0 - 1e-9:
-            lon = self.lon_deg[0] + np.mod(lon - self.lon_deg[0], 360.0)
         i = np.clip(np.searchsorted(self.t_s, dt, side="right") - 1, 0, max(self.t_s.size - 2, 0))
         j = np.clip(np.searchsorted(self.lat_deg, lat, side="right") - 1, 0, self.lat_deg.size - 2)
-        k = np.clip(np.searchsorted(self.lon_deg, lon, side="right") - 1, 0, self.lon_deg.size - 2)
         wy = (lat - self.lat_deg[j]) / (self.lat_deg[j + 1] - self.lat_deg[j])
-        wx = (lon - self.lon_deg[k]) / (self.lon_deg[k + 1] - self.lon_deg[k])
+        eps = 1e-9
+        inside = (lat >= self.lat_deg[0] - eps) & (lat <= self.lat_deg[-1] + eps)
 
         def grid(ti):
+            lon_i = lon + (dt - self.t_s[ti]) * (360.0 / 86400.0)     # the map rotated with the Sun
+            if self.lon_deg[-1] - self.lon_deg[0] >= 360.0 - 1e-9:
+                lon_i = self.lon_deg[0] + np.mod(lon_i - self.lon_deg[0], 360.0)
+            k = np.clip(np.searchsorted(self.lon_deg, lon_i, side="right") - 1, 0, self.lon_deg.size - 2)
+            wx = (lon_i - self.lon_deg[k]) / (self.lon_deg[k + 1] - self.lon_deg[k])
             g = self.tec_tecu[ti]
-            return ((1 - wy) * (1 - wx) * g[j, k] + (1 - wy) * wx * g[j, k + 1]
-                    + wy * (1 - wx) * g[j + 1, k] + wy * wx * g[j + 1, k + 1])
+            value = ((1 - wy) * (1 - wx) * g[j, k] + (1 - wy) * wx * g[j, k + 1]
+                     + wy * (1 - wx) * g[j + 1, k] + wy * wx * g[j + 1, k + 1])
+            ok = (lon_i >= self.lon_deg[0] - eps) & (lon_i <= self.lon_deg[-1] + eps)
+            return np.where(ok, value, np.nan)
 
         if self.t_s.size == 1:
             out = grid(np.zeros_like(i))
-            inside_t = np.abs(dt) < 1e-6
+            inside &= np.abs(dt) < 1e-6
         else:
             wt = (dt - self.t_s[i]) / (self.t_s[i + 1] - self.t_s[i])
             out = (1 - wt) * grid(i) + wt * grid(i + 1)
-            inside_t = (dt >= self.t_s[0]) & (dt <= self.t_s[-1])
-        eps = 1e-9
-        inside = (inside_t & (lat >= self.lat_deg[0] - eps) & (lat <= self.lat_deg[-1] + eps)
-                  & (lon >= self.lon_deg[0] - eps) & (lon <= self.lon_deg[-1] + eps))
+            inside &= (dt >= self.t_s[0]) & (dt <= self.t_s[-1])
         return np.where(inside, out, np.nan)
 
     def covers(self, week, sow) -> bool:
