@@ -26,6 +26,8 @@ from ..errors import DataFileError
 TECU = 1e16                 # electrons per m^2
 IONO_CONSTANT = 40.3        # m^3/s^2: first-order group delay = 40.3 TEC / f^2
 _MISSING = 9999
+_MAP_LABELS = ("LAT/LON1/LON2/DLON/H", "END OF TEC MAP", "START OF TEC MAP", "EPOCH OF CURRENT MAP", "END OF FILE",
+               "START OF RMS MAP")
 
 
 @dataclass(frozen=True)
@@ -64,9 +66,9 @@ class IonexMaps:
                 lon_i = self.lon_deg[0] + np.mod(lon_i - self.lon_deg[0], 360.0)
             k = np.clip(np.searchsorted(self.lon_deg, lon_i, side="right") - 1, 0, self.lon_deg.size - 2)
             wx = (lon_i - self.lon_deg[k]) / (self.lon_deg[k + 1] - self.lon_deg[k])
-            g = self.tec_tecu[ti]
-            value = ((1 - wy) * (1 - wx) * g[j, k] + (1 - wy) * wx * g[j, k + 1]
-                     + wy * (1 - wx) * g[j + 1, k] + wy * wx * g[j + 1, k + 1])
+            g = self.tec_tecu
+            value = ((1 - wy) * (1 - wx) * g[ti, j, k] + (1 - wy) * wx * g[ti, j, k + 1]
+                     + wy * (1 - wx) * g[ti, j + 1, k] + wy * wx * g[ti, j + 1, k + 1])
             ok = (lon_i >= self.lon_deg[0] - eps) & (lon_i <= self.lon_deg[-1] + eps)
             return np.where(ok, value, np.nan)
 
@@ -102,10 +104,10 @@ def read_ionex(path) -> IonexMaps:
             lines = raw.read().splitlines()
     except OSError as exc:
         raise DataFileError(path, f"cannot read IONEX file: {exc.strerror or exc}") from None
-    return _Parser(path, lines).parse()
+    return _IonexReader(path, lines).parse()
 
 
-class _Parser:
+class _IonexReader:
     def __init__(self, path: Path, lines: list[str]):
         self.path, self.lines, self.n = path, lines, 0
 
@@ -136,52 +138,23 @@ class _Parser:
             raise self.error(f"{label!r}: not a valid epoch ({exc})") from None
 
     def parse(self) -> IonexMaps:
-        data, label = self.next("'IONEX VERSION / TYPE'")
-        if label != "IONEX VERSION / TYPE":
-            raise self.error(f"expected the first line labelled 'IONEX VERSION / TYPE', got {label!r}")
-        try:
-            version = float(data[:8])
-        except ValueError:
-            raise self.error(f"unreadable IONEX version {data[:8].strip()!r}") from None
-        if not 1.0 <= version < 2.0:
-            raise self.error(f"IONEX version {version:g} is not supported (expected 1.x)")
-        head = {}
-        while True:
-            data, label = self.next("'END OF HEADER'")
-            if label == "END OF HEADER":
-                end_of_header = self.n
-                break
-            head.setdefault(label, (data, self.n))
-        for need in ("EPOCH OF FIRST MAP", "# OF MAPS IN FILE", "BASE RADIUS", "HGT1 / HGT2 / DHGT",
-                     "LAT1 / LAT2 / DLAT", "LON1 / LON2 / DLON"):
-            if need not in head:
-                raise self.error(f"header has no {need!r} line")
+        head = self.header()
         g = {k: self.numbers(head[k][0].replace("-", " -"), float, 3, k, head[k][1])
              for k in ("HGT1 / HGT2 / DHGT", "LAT1 / LAT2 / DLAT", "LON1 / LON2 / DLON")}
-        dim = int(self.numbers(head["MAP DIMENSION"][0], int, 1, "MAP DIMENSION", head["MAP DIMENSION"][1])[0]) if "MAP DIMENSION" in head \
-            else 2
+        dim = self.integer(head, "MAP DIMENSION", 2)
         h1, h2, _ = g["HGT1 / HGT2 / DHGT"]
         if dim != 2 or h1 != h2:
             raise self.error(f"only 2-D maps (one shell height) are supported, got MAP DIMENSION {dim}, "
                              f"heights {h1:g}..{h2:g} km", head.get("MAP DIMENSION", head["HGT1 / HGT2 / DHGT"])[1])
-        lat1, lat2, dlat = g["LAT1 / LAT2 / DLAT"]
-        lon1, lon2, dlon = g["LON1 / LON2 / DLON"]
-        for name, (a, b, d) in (("LAT1 / LAT2 / DLAT", (lat1, lat2, dlat)), ("LON1 / LON2 / DLON", (lon1, lon2, dlon))):
-            if d == 0 or (b - a) / d < 1 or abs((b - a) / d - round((b - a) / d)) > 1e-6:
-                raise self.error(f"{name!r}: expected a grid with a whole number (>= 1) of steps, got "
-                                 f"{a:g} {b:g} {d:g}", head[name][1])
-        n_lat, n_lon = int(round((lat2 - lat1) / dlat)) + 1, int(round((lon2 - lon1) / dlon)) + 1
-        expo = int(self.numbers(head["EXPONENT"][0], int, 1, "EXPONENT", head["EXPONENT"][1])[0]) if "EXPONENT" in head else -1
-        n_maps = int(self.numbers(head["# OF MAPS IN FILE"][0], int, 1, "# OF MAPS IN FILE", head["# OF MAPS IN FILE"][1])[0])
+        lats, lons = (self.axis(head, name, *g[name]) for name in ("LAT1 / LAT2 / DLAT", "LON1 / LON2 / DLON"))
+        expo, n_maps = self.integer(head, "EXPONENT", -1), self.integer(head, "# OF MAPS IN FILE", None)
         radius = self.numbers(head["BASE RADIUS"][0], float, 1, "BASE RADIUS", head["BASE RADIUS"][1])[0]
         mapping = head["MAPPING FUNCTION"][0].strip() if "MAPPING FUNCTION" in head else "COSZ"
-        self.n = head["EPOCH OF FIRST MAP"][1]  # errors in the epoch name its line
+        end_of_header, self.n = self.n, head["EPOCH OF FIRST MAP"][1]  # errors in the epoch name its line
         first = self.epoch(head["EPOCH OF FIRST MAP"][0], "EPOCH OF FIRST MAP")
         self.n = end_of_header
-        lats = lat1 + dlat * np.arange(n_lat)
-        lons = lon1 + dlon * np.arange(n_lon)
         epochs, maps = [], []
-        while self.n < len(self.lines):
+        while True:
             data, label = self.next("a map or 'END OF FILE'")
             if label == "END OF FILE":
                 break
@@ -205,6 +178,41 @@ class _Parser:
         return IonexMaps(path=str(self.path), first_week=week, first_sow=sow, t_s=t, lat_deg=lats[lat_order],
                          lon_deg=lons[lon_order], tec_tecu=tec[:, lat_order][:, :, lon_order], height_m=h1 * 1e3,
                          base_radius_m=radius * 1e3, mapping_function=mapping)
+
+    def header(self) -> dict:
+        """Header label -> (data columns, line number) after checking the version line and the needed labels."""
+        data, label = self.next("'IONEX VERSION / TYPE'")
+        if label != "IONEX VERSION / TYPE":
+            raise self.error(f"expected the first line labelled 'IONEX VERSION / TYPE', got {label!r}")
+        try:
+            version = float(data[:8])
+        except ValueError:
+            raise self.error(f"unreadable IONEX version {data[:8].strip()!r}") from None
+        if not 1.0 <= version < 2.0:
+            raise self.error(f"IONEX version {version:g} is not supported (expected 1.x)")
+        head = {}
+        while True:
+            data, label = self.next("'END OF HEADER'")
+            if label == "END OF HEADER":
+                break
+            head.setdefault(label, (data, self.n))
+        for need in ("EPOCH OF FIRST MAP", "# OF MAPS IN FILE", "BASE RADIUS", "HGT1 / HGT2 / DHGT",
+                     "LAT1 / LAT2 / DLAT", "LON1 / LON2 / DLON"):
+            if need not in head:
+                raise self.error(f"header has no {need!r} line")
+        return head
+
+    def integer(self, head: dict, label: str, default):
+        if label not in head:
+            return default
+        return int(self.numbers(head[label][0], int, 1, label, head[label][1])[0])
+
+    def axis(self, head: dict, name: str, a: float, b: float, d: float) -> np.ndarray:
+        """Grid values a, a + d, ..., b of header line ``name``."""
+        if d == 0 or (b - a) / d < 1 or abs((b - a) / d - round((b - a) / d)) > 1e-6:
+            raise self.error(f"{name!r}: expected a grid with a whole number (>= 1) of steps, got {a:g} {b:g} {d:g}",
+                             head[name][1])
+        return a + d * np.arange(int(round((b - a) / d)) + 1)
 
     def skip(self, end_label: str) -> None:
         while True:
@@ -234,6 +242,9 @@ class _Parser:
             values = []
             for _ in range(per_row):
                 text, lab = self.next(f"{lons.size} TEC values for latitude {lat:g}")
+                if lab in _MAP_LABELS:     # a data line's columns 61-80 hold values, not a label
+                    raise self.error(f"latitude {lat:g}: expected {lons.size} TEC values, got {len(values)} "
+                                     f"before the line labelled {lab!r}")
                 line = self.lines[self.n - 1]
                 for c in range(0, len(line.rstrip()), 5):
                     field = line[c:c + 5].strip()

@@ -105,7 +105,7 @@ _GNSS = [
     _f("gnss/truth/antenna_pos_ecef", "f8", ("M", "A", 3), "m", "ECEF", "gnss", "antenna phase centres"),
     _f("gnss/truth/antenna_vel_ecef", "f8", ("M", "A", 3), "m/s", "ECEF", "gnss", "phase-centre velocities"),
     _f("gnss/truth/range", "f8", ("M", "A", "S"), "m", "", "gnss",
-       "geometric range (light time and Earth rotation included)"),
+       "geometric range to the true satellite (light time and Earth rotation included)"),
     _f("gnss/truth/range_rate", "f8", ("M", "A", "S"), "m/s", "", "gnss", "exact derivative of the range"),
     _f("gnss/truth/elevation", "f8", ("M", "A", "S"), "rad", "ENU", "gnss", "elevation at each antenna"),
     _f("gnss/truth/azimuth", "f8", ("M", "A", "S"), "rad", "ENU", "gnss", "azimuth, clockwise from north"),
