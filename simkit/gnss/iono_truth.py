@@ -54,10 +54,17 @@ class ResidualField:
         self.phase = gen.uniform(0.0, 2.0 * np.pi, n_features)
         self.scale = np.sqrt(2.0 / n_features)
 
-    def __call__(self, x, t):
-        """e at Earth-fixed points ``x`` (..., 3) m and times ``t`` (...) s (broadcast together)."""
-        arg = x @ self.k.T + np.asarray(t)[..., None] * self.w + self.phase
-        return self.scale * np.cos(arg).sum(axis=-1)
+    def __call__(self, x, t, chunk: int = 1 << 15):
+        """e at Earth-fixed points ``x`` (..., 3) m and times ``t`` (...) s (broadcast together); evaluated
+        ``chunk`` points at a time so that memory stays bounded (chunk x features)."""
+        x, t = np.broadcast_arrays(x, np.asarray(t, dtype=float)[..., None])
+        shape = x.shape[:-1]
+        xs, ts = x.reshape(-1, 3), t[..., 0].reshape(-1)
+        out = np.empty(xs.shape[0])
+        for i in range(0, xs.shape[0], chunk):
+            arg = xs[i:i + chunk] @ self.k.T + ts[i:i + chunk, None] * self.w + self.phase
+            out[i:i + chunk] = np.cos(arg).sum(axis=-1)
+        return self.scale * out.reshape(shape)
 
 
 class TruthIonosphere:
