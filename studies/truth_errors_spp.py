@@ -25,6 +25,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def case(out: Path, signal: str, model: str, seed: int, extra: list[str]) -> dict:
     f = out / f"{signal}_{model}_{seed}.h5"
+    if f.with_suffix(".json").is_file():     # done by an earlier call with the same OUT_DIR
+        return json.loads(f.with_suffix(".json").read_text())["statistics"]
     sim = [sys.executable, "-m", "simkit"]
     subprocess.run(sim + ["run", "examples/truth_errors_static.toml", "-o", str(f), "--seed", str(seed),
                           "--set", f'gnss.signals=["{signal}"]', "--set", f"gnss.truth_errors.model='{model}'"]

@@ -89,13 +89,20 @@ class GnssSimulator:
             return
         ionex = None
         if te.ionex_file is not None:
-            from ..constellation.sources import resolve
+            from pathlib import Path
 
-            ionex = read_ionex(resolve(te.ionex_file))
+            path = Path(te.ionex_file).expanduser()
+            if not path.is_file():
+                raise ScenarioError("gnss.truth_errors.ionex_file", f"{te.ionex_file}: no such file (expected an "
+                                    "IONEX 1.0 file, plain or .gz)")
+            ionex = read_ionex(path)
             end_w, end_s = gpstime.add_seconds(self.start_week, self.start_sow, self.duration_s)
             if not ionex.covers(np.array([self.start_week, end_w]), np.array([self.start_sow, end_s])):
-                raise ScenarioError("gnss.truth_errors.ionex_file", f"{te.ionex_file}: its TEC maps do not cover "
-                                    "the run (from scenario.start for scenario.duration_s)")
+                first = gpstime.gps_to_utc(ionex.first_week, ionex.first_sow)
+                last = gpstime.gps_to_utc(*gpstime.add_seconds(ionex.first_week, ionex.first_sow, ionex.t_s[-1]))
+                span = f"{first:%Y-%m-%d %H:%M} to {last:%Y-%m-%d %H:%M} UTC"
+                raise ScenarioError("gnss.truth_errors.ionex_file", f"{te.ionex_file}: its TEC maps ({span}) do not "
+                                    "cover the run (scenario.start, scenario.duration_s)")
         iono = TruthIonosphere(seed, te.iono_residual_fraction, te.iono_correlation_length_km * 1e3,
                                te.iono_correlation_time_s, ionex)
         self.truth_iono = iono if iono.departs else None
