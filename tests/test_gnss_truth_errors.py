@@ -296,3 +296,53 @@ def test_truth_error_keys_are_validated_with_the_key_named(table, key, words):
 def test_ionex_that_does_not_cover_the_run_is_a_scenario_error():
     with pytest.raises(ScenarioError, match="gnss.truth_errors.ionex_file: .*do not cover"):
         make({"truth_errors": {"ionex_file": str(IONEX)}}, duration=60.0, start=(WEEK, 86400.0 + 15 * 3600.0))
+
+
+@pytest.mark.parametrize("content, expect", [
+    ("garbage\n", "bad.16i:1: expected the first line labelled 'IONEX VERSION / TYPE'"),
+    (None, "gnss.truth_errors.ionex_file: "),
+    ("copy", "do not cover the run"),
+])
+def test_simkit_run_with_a_bad_ionex_file_is_one_line_and_writes_nothing(tmp_path, content, expect):
+    from cli_errors import assert_clean_error
+
+    bad = tmp_path / "bad.16i"
+    if content == "copy":
+        shutil.copyfile(IONEX, bad)
+    elif content is not None:
+        bad.write_text(content)
+    assert_clean_error(["run", "quickstart", "-o", str(tmp_path / "q.h5"), "--set",
+                        f"gnss.truth_errors.ionex_file='{bad}'"], tmp_path, expect=expect)
+
+
+def test_spp_sees_metres_with_the_truth_errors_and_millimetres_once_the_stored_errors_are_removed(tmp_path):
+    """Noise and multipath off: SPP (broadcast Klobuchar, Saastamoinen, broadcast orbit and clock) on the default
+    truth is off by metres; the same file with each code corrected by its stored model errors closes at mm, so the
+    stored terms are the whole of what the receiver's models miss."""
+    import h5py
+
+    import simkit
+    from simkit.estimators.registry import DEFAULTS, spp_fixes
+    from simkit.gnss import signals
+
+    quiet = ["scenario.duration_s=20", "imu.preset=ideal", "gnss.errors.multipath=false", "gnss.errors.noise=false"]
+    real = simkit.run("quickstart", out=tmp_path / "real.h5", overrides=quiet)
+    fixed = tmp_path / "fixed.h5"
+    shutil.copyfile(real, fixed)
+    with h5py.File(fixed, "a") as f:
+        t = f["gnss/truth"]
+        common = t["orbit_range_error"][:] + t["satellite_clock_error"][:][:, None] + t["troposphere_model_error"][:]
+        for sig in f["gnss/obs"]:
+            g = signals.get(sig)
+            scale = (reference_frequency(g.system) / g.freq_hz) ** 2
+            code = f[f"gnss/obs/{sig}/code"]
+            code[...] = code[:] - common - t["ionosphere_model_error"][:] * scale
+    err = {}
+    for name, path in (("real", real), ("fixed", fixed)):
+        with simkit.open(path) as ds:
+            fx = spp_fixes(ds, dict(DEFAULTS["spp"]))
+            err[name] = np.linalg.norm(fx.pos_ecef - ds["gnss/truth/antenna_pos_ecef"][:, 0], axis=-1)
+    print(f"\nSPP 3-D error: default truth RMS {np.sqrt(np.mean(err['real'] ** 2)):.2f} m, "
+          f"with the stored errors removed max {err['fixed'].max() * 1e3:.2f} mm")
+    assert np.sqrt(np.mean(err["real"] ** 2)) > 0.5
+    assert err["fixed"].max() < 5e-3
