@@ -15,6 +15,10 @@ pierce point, elevation, azimuth and time), so Doppler matches the time-differen
 :meth:`GnssSimulator.process` runs named steps (antennas, geometry, visibility, clocks, atmosphere, random draws
 and multipath, tracking, assembly); the state carried between calls makes the output independent of the block
 split.
+
+By default (``gnss.truth_errors``, docs/truth_errors.md) rho is the range to the *true* satellite (the broadcast one
+of ``/gnss/sat_pos_ecef`` plus an orbit error), dT^s the true clock, and I and T depart from the broadcast Klobuchar
+and the Saastamoinen 1/sin(el) models that a receiver applies; each departure is stored in ``/gnss/truth``.
 """
 from __future__ import annotations
 
