@@ -26,7 +26,8 @@ def _truth(ds, a=0):
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("spp")
-    quiet = ["scenario.duration_s=20", "imu.preset=ideal", "gnss.errors.multipath=false", "gnss.errors.noise=false"]
+    quiet = ["scenario.duration_s=20", "imu.preset=ideal", "gnss.errors.multipath=false", "gnss.errors.noise=false",
+             "gnss.truth_errors.model='none'"]  # the receiver's models are the truth: SPP closes at mm
     clean = simkit.run("quickstart", out=d / "clean.h5", overrides=quiet + ["gnss.errors.ionosphere=false"])
     full = simkit.run("quickstart", out=d / "full.h5", overrides=["scenario.duration_s=20", "imu.preset=ideal"])
     iono = simkit.run("quickstart", out=d / "iono.h5", overrides=quiet)

@@ -200,15 +200,18 @@ def test_config_errors_name_the_key():
 
 
 def test_stored_satellite_positions_are_in_the_emission_frame_as_rtklib_expects(tmp_path):
-    """/gnss/sat_pos_ecef is the position at emission in the ECEF frame of emission (RTKLIB satposs): RTKLIB's
-    geodist (which adds the Sagnac term) on it and the true antenna positions gives the stored range < 1 mm."""
+    """/gnss/sat_pos_ecef is the position at emission in the ECEF frame of emission (RTKLIB satposs) of the
+    broadcast satellite: RTKLIB's geodist (which adds the Sagnac term) on it and the true antenna positions gives the
+    stored (true) range minus the stored broadcast orbit's range error < 1 mm."""
     import pyrtklib as rtk
 
     import simkit
 
     path = simkit.run("quickstart", out=tmp_path / "q.h5", overrides=["scenario.duration_s=20"])
     with simkit.open(path) as ds:
-        sat, ant, rng = ds["gnss/sat_pos_ecef"][:], ds["gnss/truth/antenna_pos_ecef"][:], ds["gnss/truth/range"][:]
+        sat, ant = ds["gnss/sat_pos_ecef"][:], ds["gnss/truth/antenna_pos_ecef"][:]
+        orbit = ds["gnss/truth/orbit_range_error"][:]
+        rng = ds["gnss/truth/range"][:] - orbit
         assert ds["gnss/sat_pos_ecef"].attrs["frame"] == "ECEF at emission"
     rs, rr, e = rtk.Arr1Ddouble(6), rtk.Arr1Ddouble(3), rtk.Arr1Ddouble(3)
     worst, checked = 0.0, 0
@@ -223,6 +226,7 @@ def test_stored_satellite_positions_are_in_the_emission_frame_as_rtklib_expects(
                 checked += 1
     print(f"\nRTKLIB geodist vs stored range: max {worst * 1e3:.4f} mm over {checked} ranges")
     assert checked > 100 and worst < 1e-3
+    assert np.nanstd(orbit) > 0.05  # the default truth has broadcast orbit errors (docs/truth_errors.md)
 
 
 def test_noise_of_a_satellite_does_not_depend_on_the_mask_or_the_other_satellites():

@@ -20,9 +20,11 @@ from cli_errors import assert_clean_error, run_cli
 
 @pytest.fixture(scope="module")
 def clean(tmp_path_factory):
-    """high_dynamic shortened to 20 s with error-free code and Doppler (noise and multipath off), SPP solved."""
+    """high_dynamic shortened to 20 s with error-free code and Doppler (noise and multipath off, the truth equal to
+    the receiver's atmosphere and orbit models), SPP solved."""
     path = simkit.run("high_dynamic", out=tmp_path_factory.mktemp("point") / "hd.h5",
-                      overrides=["scenario.duration_s=20", "gnss.errors.noise=false", "gnss.errors.multipath=false"])
+                      overrides=["scenario.duration_s=20", "gnss.errors.noise=false", "gnss.errors.multipath=false",
+                                 "gnss.truth_errors.model='none'"])
     with open_dataset(path) as ds:
         sol = SOLVERS["spp"](ds, {})
     write_solution(path, "spp", sol)

@@ -12,6 +12,7 @@ import numpy as np
 from ..errors import ScenarioError
 from ..section import Section, in_range, non_negative, positive
 from . import clock, signals
+from .truth_config import TruthErrorsConfig, parse_truth_errors
 
 ERROR_TERMS = ("receiver_clock", "satellite_clock", "group_delay", "ionosphere", "troposphere", "multipath",
                "noise", "cycle_slips")
@@ -83,6 +84,7 @@ class GnssConfig:
     ambiguity_max_cycles: int
     iono_coefficients: dict[str, tuple] = field(default_factory=dict)  # "gps"/"bds" -> (alpha, beta) overrides
     code_error_scale: dict[str, float] = field(default_factory=dict)  # signal -> factor on code noise + multipath
+    truth_errors: TruthErrorsConfig | None = None  # departures of the truth from the receiver's models; None: off
 
     @property
     def nav_systems(self) -> str:
@@ -127,7 +129,8 @@ def parse_config(sec: Section) -> GnssConfig:
         outages=tuple(_outage(o, len(antennas)) for o in _each(sec.sections("outage"))),
         ambiguity_max_cycles=sec.get("ambiguity_max_cycles", int, 100000, check=in_range(0, 10**8)),
         iono_coefficients=_ionosphere(sec.section("ionosphere")),
-        code_error_scale=_code_scale(sec.section("code_error_scale"), sigs))
+        code_error_scale=_code_scale(sec.section("code_error_scale"), sigs),
+        truth_errors=parse_truth_errors(sec.section("truth_errors")))
     sec.done()
     return cfg
 

@@ -63,7 +63,9 @@ class SignalTruth:
 @dataclass(frozen=True)
 class GnssTruth:
     """Signal-independent truth: antenna phase centres (M, A, 3), geometry and clocks (M, A, S) or (M, A),
-    troposphere (M, A, S)."""
+    troposphere (M, A, S); the truth minus the receiver's models (docs/truth_errors.md): ionosphere at the system's
+    reference frequency and troposphere (M, A, S), range to the true minus the broadcast satellite (M, A, S), orbit
+    error in radial/along/cross axes (M, S, 3) and the satellite clock term's error (M, S), all m."""
 
     antenna_pos_ecef: np.ndarray
     antenna_vel_ecef: np.ndarray
@@ -77,6 +79,11 @@ class GnssTruth:
     satellite_clock_drift: np.ndarray
     troposphere: np.ndarray
     troposphere_rate: np.ndarray
+    ionosphere_model_error: np.ndarray
+    troposphere_model_error: np.ndarray
+    orbit_range_error: np.ndarray
+    orbit_error_rac: np.ndarray
+    satellite_clock_error: np.ndarray
     los_state: np.ndarray | None = None        # with an [environment]: (M, A, S) uint8, see simkit.environment
     nlos_delay: np.ndarray | None = None       # with an [environment]: (M, A, S) m, extra path of the reflection
 

@@ -15,6 +15,10 @@ pierce point, elevation, azimuth and time), so Doppler matches the time-differen
 :meth:`GnssSimulator.process` runs named steps (antennas, geometry, visibility, clocks, atmosphere, random draws
 and multipath, tracking, assembly); the state carried between calls makes the output independent of the block
 split.
+
+By default (``gnss.truth_errors``, docs/truth_errors.md) rho is the range to the *true* satellite (the broadcast one
+of ``/gnss/sat_pos_ecef`` plus an orbit error), dT^s the true clock, and I and T depart from the broadcast Klobuchar
+and the Saastamoinen 1/sin(el) models that a receiver applies; each departure is stored in ``/gnss/truth``.
 """
 from __future__ import annotations
 
@@ -22,15 +26,20 @@ import numpy as np
 
 from .. import frames, gpstime, rng
 from ..constellation import Sky, antenna_view
-from ..earth import C_LIGHT
+from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
+from ..errors import DataFileError, ScenarioError
 from . import atmosphere, noise, signals as sigmod, tworay
 from .clock import ClockProcess
 from .config import GnssConfig, check_sats
 from .draws import KeyedNormals
+from .ephemeris_errors import EphemerisErrors, rac_axes
+from .ionex import read_ionex
+from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
+from .tropo_truth import TruthTroposphere
 
 _GD_NAMES = {"tgd": ("TGD",), "tgd1": ("TGD1",), "tgd2": ("TGD2",), "bgd_e5a": ("BGD_E5a",),
              "bgd_e5b": ("BGD_E5b",)}
@@ -83,6 +92,39 @@ class GnssSimulator:
         self.vis = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)
         self.nlos = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)   # tracking a reflection only
         self.sat_index = {sid: k for k, sid in enumerate(self.sat_ids)}
+        self._truth_models(seed)
+
+    def _truth_models(self, seed: int) -> None:
+        """The truth-side departures from the receiver's models (``gnss.truth_errors``, docs/truth_errors.md);
+        None where the truth equals the model."""
+        te = self.cfg.truth_errors
+        self.truth_iono = self.truth_tropo = self.ephemeris = None
+        if te is None or not te.on:
+            return
+        ionex = None
+        if te.ionex_file is not None:
+            from pathlib import Path
+
+            path = Path(te.ionex_file).expanduser()
+            if not path.is_file():
+                raise ScenarioError("gnss.truth_errors.ionex_file", f"{te.ionex_file}: no such file (expected an "
+                                    "IONEX 1.0 file, plain or .gz)")
+            ionex = read_ionex(path)
+            end_w, end_s = gpstime.add_seconds(self.start_week, self.start_sow, self.duration_s)
+            if not ionex.covers(np.array([self.start_week, end_w]), np.array([self.start_sow, end_s])):
+                first = gpstime.gps_to_utc(ionex.first_week, ionex.first_sow)
+                last = gpstime.gps_to_utc(*gpstime.add_seconds(ionex.first_week, ionex.first_sow, ionex.t_s[-1]))
+                span = f"{first:%Y-%m-%d %H:%M} to {last:%Y-%m-%d %H:%M} UTC"
+                raise ScenarioError("gnss.truth_errors.ionex_file", f"{te.ionex_file}: its TEC maps ({span}) do not "
+                                    "cover the run (scenario.start, scenario.duration_s)")
+        iono = TruthIonosphere(seed, te.iono_residual_fraction, te.iono_correlation_length_km * 1e3,
+                               te.iono_correlation_time_s, ionex)
+        self.truth_iono = iono if iono.departs else None
+        tropo = TruthTroposphere(seed, self.start_week, self.start_sow, self.duration_s, te.tropo_mapping,
+                                 te.tropo_zhd_sigma_m, te.tropo_zwd_sigma_m, te.tropo_zwd_random_walk_m_per_sqrt_h)
+        self.truth_tropo = tropo if tropo.departs else None
+        eph = EphemerisErrors(seed, self.sat_ids, te.ephemeris)
+        self.ephemeris = eph if eph.departs else None
 
     def _group_delays(self) -> np.ndarray:
         """Broadcast group delay (S, G) s per satellite and signal, records nearest the middle of the run."""
@@ -145,7 +187,7 @@ class GnssSimulator:
         vis_c, off = self._visibility(t, view, c_be, cand, los)
         k0 = int(round(t[0] * self.cfg.rate_hz))
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
-        parts = _Parts(self, t, sow, cand, view, vis_c, off, draws, los)
+        parts = _Parts(self, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los)
         return GnssEpochs(t=t, sat_pos_ecef=ref["sat_pos_emission"], sat_clock=ref["sat_clock"],
                           truth=parts.truth(ant_pos, ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
 
@@ -195,8 +237,9 @@ class GnssSimulator:
 class _Parts:
     """The error terms and observables of one block, computed step by step on the candidate columns."""
 
-    def __init__(self, sim: GnssSimulator, t, sow, cand, view, vis_c, off, draws, los=None):
+    def __init__(self, sim: GnssSimulator, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los=None):
         self.sim, self.cand, self.view, self.m, self.los = sim, cand, view, t.size, los
+        self.t, self.week, self.sow = t, week, sow
         self.shape = (t.size, sim.n_ant, len(sim.sat_ids))
         err = sim.cfg.errors
         vis = self.full(vis_c, False)
@@ -211,10 +254,11 @@ class _Parts:
             sim.nlos = nlos[-1].copy()
             reacquire = switch[..., None] & sim.carries[None, None, :, :]
         self._clocks(err)
+        self._ephemeris(err, ref, ant_vel)
         self.el = np.where(np.isfinite(view.elevation), np.maximum(view.elevation, 1e-3), np.pi / 2)
         self.az = np.where(np.isfinite(view.azimuth), view.azimuth, 0.0)
         self._troposphere(err)
-        self._ionosphere(err, sow)
+        self._ionosphere(err)
         self.mp = sim.mp.advance(draws[..., 3:5], restart, index=(slice(None), cand)) if err["multipath"] else None
         amb, lli = sim.tracking.advance(t, tracked, reacquire)
         self.obs, self.signal_truth = {}, {}
@@ -238,31 +282,86 @@ class _Parts:
         self.clk = self.rx_clk[..., None] + self.sat_clk
         self.clk_rate = self.rx_clk_rate[..., None] + self.sat_clk_rate
 
+    def _ephemeris(self, err, ref, ant_vel):
+        """Broadcast orbit and clock errors: the true range differs from the range to the broadcast satellite by
+        ``orb`` (M, A, C) m, the true clock term by ``sat_clk_error`` (M, S) m (see ephemeris_errors)."""
+        sim, view, cand = self.sim, self.view, self.cand
+        n_sat = len(sim.sat_ids)
+        self.orbit_rac = np.zeros((self.m, n_sat, 3))
+        self.sat_clk_error = np.zeros((self.m, n_sat))
+        self.orb = self.orb_rate = np.zeros(view.range.shape)
+        self.range, self.range_rate = view.range, view.range_rate
+        if sim.ephemeris is None:
+            return
+        e, e_rate = sim.ephemeris.at(self.week, self.sow, np.arange(n_sat))           # (M, S, 4)
+        known = np.isfinite(ref["sat_pos"]).all(axis=-1)
+        self.orbit_rac = np.where(known[..., None], e[..., :3], np.nan)
+        on = err["satellite_clock"]
+        self.sat_clk_error = np.where(known, -e[..., 3] * on, np.nan)
+        self.sat_clk = self.sat_clk - e[:, None, cand, 3] * on
+        self.sat_clk_rate = self.sat_clk_rate - e_rate[:, None, cand, 3] * (1.0 - view.range_rate / C_LIGHT) * on
+        self.clk = self.rx_clk[..., None] + self.sat_clk
+        self.clk_rate = self.rx_clk_rate[..., None] + self.sat_clk_rate
+        pos, vel = np.nan_to_num(ref["sat_pos"][:, cand]), np.nan_to_num(ref["sat_vel"][:, cand])
+        v_in = vel + np.cross(EARTH_RATE_ECEF, pos)
+        rel = vel[:, None] - ant_vel[:, :, None]          # d(satellite - antenna)/dt in the rotating frame
+        diff = view.los * view.range[..., None]
+        rac, rac_rate = e[:, cand, :3], e_rate[:, cand, :3]
+
+        def at(s):
+            with np.errstate(invalid="ignore"):
+                axes = rac_axes(pos + s * vel, v_in)                                     # (M, C, 3, 3)
+            d = np.einsum("mcki,mck->mci", axes, rac + s * rac_rate)
+            x = diff + s * rel
+            return np.linalg.norm(x + d[:, None], axis=-1) - np.linalg.norm(x, axis=-1)
+
+        h = 0.5
+        self.orb = at(0.0)
+        self.orb_rate = (at(h) - at(-h)) / (2.0 * h)
+        self.range, self.range_rate = view.range + self.orb, view.range_rate + self.orb_rate
+
     def _troposphere(self, err):
         view = self.view
         lat, hgt = view.lla[..., 0, None], view.lla[..., 2, None]
-        if err["troposphere"]:
+        self.trop_error = np.zeros(self.el.shape)
+        if err["troposphere"] and self.sim.truth_tropo is not None:
+            self.trop, self.trop_rate, model = self.sim.truth_tropo.slant(
+                lat, hgt, self.el, view.vel_enu[..., 2, None], view.elevation_rate, self.t[:, None, None])
+            self.trop_error = self.trop - model
+        elif err["troposphere"]:
             self.trop = atmosphere.troposphere(lat, hgt, self.el)
             self.trop_rate = atmosphere.troposphere_rate(lat, hgt, self.el, view.vel_enu[..., 2, None],
                                                          view.elevation_rate)
         else:
             self.trop = self.trop_rate = np.zeros(self.el.shape)
 
-    def _ionosphere(self, err, sow):
+    def _ionosphere(self, err):
         """Delay (M, A, C) m at each model's reference frequency (L1 for GPS, Galileo, QZSS, GLONASS; B1I for
-        BDS) and its rate."""
+        BDS), its rate, and the truth minus the broadcast model."""
         self.iono = np.zeros(self.el.shape)
         self.iono_rate = np.zeros(self.el.shape)
+        self.iono_error = np.zeros(self.el.shape)
         if not err["ionosphere"]:
             return
-        view, system = self.view, self.sim.iono_model[self.cand]
+        view, system, truth = self.view, self.sim.iono_model[self.cand], self.sim.truth_iono
+        sow = self.sow[:, None, None]
         for letter in "GC":
             cols = system == letter
-            if cols.any():
-                alpha, beta = self.sim.iono[letter]
-                self.iono[..., cols], self.iono_rate[..., cols] = atmosphere.ionosphere(
-                    letter, alpha, beta, view.lla, view.vel_enu, self.az[..., cols], self.el[..., cols],
-                    view.azimuth_rate[..., cols], view.elevation_rate[..., cols], sow[:, None, None])
+            if not cols.any():
+                continue
+            alpha, beta = self.sim.iono[letter]
+            args = (letter, alpha, beta, view.lla, view.vel_enu, self.az[..., cols], self.el[..., cols],
+                    view.azimuth_rate[..., cols], view.elevation_rate[..., cols])
+            if truth is None:
+                self.iono[..., cols], self.iono_rate[..., cols] = atmosphere.ionosphere(*args, sow)
+                continue
+            iono, rate, klob = truth.delay(*args, self.week[:, None, None], sow, self.t[:, None, None])
+            seen = np.isfinite(view.range[..., cols])
+            if not np.all(np.isfinite(iono)[seen]):
+                raise DataFileError(truth.ionex.path, "the TEC maps have no value at a pierce point of the run "
+                                    "(a regional map, or missing values)")
+            self.iono[..., cols], self.iono_rate[..., cols] = iono, rate
+            self.iono_error[..., cols] = iono - klob
 
     def _signal(self, j, g, off, draws, tracked, amb, lli):
         """Observables and error terms of signal ``g`` (index ``j``) on the columns that transmit it."""
@@ -289,11 +388,12 @@ class _Parts:
         mp_rate = None
         if self.los is not None:
             cn0, mp_c, mp_p, mp_rate = self._environment(cj, g, cn0, mp_c, mp_p)
-            sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g))
+            sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g, lam))
+            sig_c = sig_c * code_scale
         n_c, n_p, n_d = (draws[:, :, cj, j, i] * s for i, s in enumerate((sig_c, sig_p, sig_d)))
         gd = C_LIGHT * sim.group_delay_s[cols, j] * err["group_delay"]
-        base = self.view.range[..., cj] + self.clk[..., cj] + self.trop[..., cj]
-        rate = self.view.range_rate[..., cj] + self.clk_rate[..., cj] + self.trop_rate[..., cj]
+        base = self.range[..., cj] + self.clk[..., cj] + self.trop[..., cj]
+        rate = self.range_rate[..., cj] + self.clk_rate[..., cj] + self.trop_rate[..., cj]
         keep = tracked[..., cols, j]
 
         def put(x, masked=False):
@@ -340,11 +440,15 @@ class _Parts:
 
     def truth(self, ant_pos, ant_vel) -> GnssTruth:
         v = self.view
-        return GnssTruth(antenna_pos_ecef=ant_pos, antenna_vel_ecef=ant_vel, range=self.full(v.range),
-                         range_rate=self.full(v.range_rate), elevation=self.full(v.elevation),
+        return GnssTruth(antenna_pos_ecef=ant_pos, antenna_vel_ecef=ant_vel, range=self.full(self.range),
+                         range_rate=self.full(self.range_rate), elevation=self.full(v.elevation),
                          azimuth=self.full(v.azimuth), receiver_clock=self.rx_clk,
                          receiver_clock_drift=self.rx_clk_rate, satellite_clock=self.full(self.sat_clk),
                          satellite_clock_drift=self.full(self.sat_clk_rate), troposphere=self.full(self.trop),
                          troposphere_rate=self.full(self.trop_rate),
+                         ionosphere_model_error=self.full(self.iono_error),
+                         troposphere_model_error=self.full(self.trop_error),
+                         orbit_range_error=self.full(self.orb), orbit_error_rac=self.orbit_rac,
+                         satellite_clock_error=self.sat_clk_error,
                          los_state=None if self.los is None else self.full(self.los.state, 255),
                          nlos_delay=None if self.los is None else self.full(self.los.extra))

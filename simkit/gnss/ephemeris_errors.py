@@ -1,0 +1,77 @@
+"""Broadcast orbit and clock errors: where the true satellite is, relative to where its ephemeris puts it.
+
+The file's ``/gnss/sat_pos_ecef`` and ``/gnss/sat_clock`` stay the broadcast orbit and clock (what a receiver
+computes from the navigation message); the observables are formed with the true satellite, displaced by an orbit
+error in radial, along-track and cross-track axes (RAC), and the true clock, offset by a clock error.
+
+Per satellite and ephemeris interval (the record with the nearest toe, toes every ``interval_s`` of GPS time, as
+GPS's 2 h and BDS's 1 h uploads), each of the four components (R, A, C, clock) is a quadratic in the normalised time
+tau = (t - toe) / (interval/2) in [-1, 1):
+
+    e(tau) = sigma (sqrt(0.5) z0 + sqrt(0.9) z1 tau + sqrt(45/16) z2 (tau^2 - 1/3))
+
+with z ~ N(0, 1) drawn from the stream ``gnss/ephemeris/<sat>/<interval index>``, so that the RMS over an interval is
+sigma; the errors jump at each ephemeris update and are smooth in between. The RAC axes: R along the satellite's
+position, C along r x v (inertial velocity), A = C x R.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import rng
+from ..gpstime import SECONDS_PER_WEEK
+from .truth_config import EphemerisErrorConfig
+
+_SHAPE = np.array([np.sqrt(0.5), np.sqrt(0.9), np.sqrt(45.0 / 16.0)])
+
+
+def rac_axes(pos, vel_inertial):
+    """Radial, along-track and cross-track unit vectors (..., 3, 3) (rows R, A, C) of satellites at ``pos``
+    (..., 3) m moving at ``vel_inertial`` (..., 3) m/s."""
+    r = pos / np.linalg.norm(pos, axis=-1, keepdims=True)
+    c = np.cross(pos, vel_inertial)
+    c /= np.linalg.norm(c, axis=-1, keepdims=True)
+    return np.stack([r, np.cross(c, r), c], axis=-2)
+
+
+class EphemerisErrors:
+    """Orbit (RAC) and clock errors of satellites ``sat_ids`` under scenario ``seed``; ``systems`` maps a system
+    letter to its :class:`EphemerisErrorConfig` (satellites of other systems get none)."""
+
+    def __init__(self, seed: int, sat_ids, systems: dict[str, EphemerisErrorConfig]):
+        self.seed, self.sat_ids = seed, list(sat_ids)
+        cfgs = [systems.get(s[0]) for s in self.sat_ids]
+        self.sigma = np.array([(*c.orbit_sigma_rac_m, c.clock_sigma_m) if c else (0.0,) * 4 for c in cfgs])
+        self.interval = np.array([c.interval_s if c else 7200.0 for c in cfgs])
+        self.departs = bool(np.any(self.sigma > 0))
+        self._coef: dict[tuple[int, int], np.ndarray] = {}
+
+    def _coefficients(self, s: int, j: int) -> np.ndarray:
+        key = (s, j)
+        if key not in self._coef:
+            z = rng.generator(self.seed, "gnss", "ephemeris", self.sat_ids[s], str(j)).standard_normal((3, 4))
+            self._coef[key] = z * _SHAPE[:, None] * self.sigma[s]
+        return self._coef[key]
+
+    def at(self, week, sow, cols):
+        """Errors (M, C, 4) m [radial, along, cross, clock] and their rates (M, C, 4) m/s at GPS times
+        (``week``, ``sow``) (M,) for satellite columns ``cols`` (C,). The clock error is c (dT_true - dT_broadcast)."""
+        t_abs = np.asarray(week, dtype=float) * SECONDS_PER_WEEK + np.asarray(sow, dtype=float)   # (M,)
+        out = np.zeros((t_abs.size, cols.size, 4))
+        rate = np.zeros_like(out)
+        for c, s in enumerate(cols):
+            if not np.any(self.sigma[s] > 0):
+                continue
+            half = 0.5 * self.interval[s]
+            j = np.floor(t_abs / self.interval[s] + 0.5).astype(np.int64)
+            tau = (t_abs - j * self.interval[s]) / half
+            for jj in np.unique(j):
+                rows = j == jj
+                z0, z1, z2 = self._coefficients(s, int(jj))
+                tt = tau[rows, None]
+                out[rows, c] = z0 + z1 * tt + z2 * (tt**2 - 1.0 / 3.0)
+                rate[rows, c] = (z1 + 2.0 * z2 * tt) / half
+        # keep the cache small: intervals far behind the last epoch are never asked for again (epochs in order)
+        if len(self._coef) > 4 * len(self.sat_ids):
+            self._coef.clear()
+        return out, rate
