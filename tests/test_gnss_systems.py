@@ -30,7 +30,8 @@ def five(tmp_path_factory):
     """quickstart (Xi'an, 2026-04-27, moving car) with every signal of the five systems, noise and multipath off."""
     out = tmp_path_factory.mktemp("five") / "five.h5"
     return simkit.run("quickstart", out=out, overrides=[f"gnss.signals={FIVE}", "gnss.errors.noise=false",
-                                                        "gnss.errors.multipath=false", "scenario.duration_s=20"])
+                                                        "gnss.errors.multipath=false", "scenario.duration_s=20",
+                                                        "gnss.truth_errors.model='none'"])
 
 
 def _rtklib_channels(tmp_path):

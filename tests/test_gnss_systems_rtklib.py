@@ -49,6 +49,7 @@ def one_group_delay_per_satellite(src: Path, dst: Path) -> Path:
 def _spp(tmp, nav, start, origin, signals, errors_off, navsys, iono):
     over = [f'scenario.start="{start}"', "scenario.duration_s=60", f"gnss.constellation=[{{source='{nav}'}}]",
             f"gnss.signals={signals}", "gnss.errors.noise=false", "gnss.errors.multipath=false", "imu.preset=ideal",
+            "gnss.truth_errors.model='none'",
             f"trajectory.origin={{lat_deg={origin[0]}, lon_deg={origin[1]}, height_m={origin[2]}}}"]
     over += [f"gnss.errors.{e}=false" for e in errors_off]
     path = simkit.run("xian_static_bds", out=tmp / "s.h5", overrides=over)
