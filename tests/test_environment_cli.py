@@ -13,19 +13,28 @@ from cli_errors import assert_clean_error, run_cli
 SITE = ["--lat", "34.2", "--lon", "108.9", "--height", "401.2", "--start", "2026-04-27T06:00:00Z"]
 
 
+def _all_column(stdout):
+    """The token index of the 'all' count in the epoch rows (one per system before it; the date and the time are
+    two tokens where the header has 'UTC')."""
+    header = next(ln.split() for ln in stdout.splitlines() if ln.startswith("UTC"))
+    return header.index("all") + 1
+
+
 def test_sky_with_an_environment_counts_each_state(tmp_path):
     out = run_cli(["sky", *SITE, "--hours", "1", "--step", "900", "--environment", str(resolve("urban_canyon")),
                    "--plot", "sky.png"], tmp_path)
     assert out.returncode == 0, out.stderr
     rows = [ln.split() for ln in out.stdout.splitlines() if ln.startswith("2026-04-27")]
+    col = _all_column(out.stdout)
     assert len(rows) == 5
     for r in rows:
-        total, direct, both, nlos, blocked = int(r[4]), *(int(x) for x in r[-4:])
+        total, direct, both, nlos, blocked = int(r[col]), *(int(x) for x in r[-4:])
         assert total == direct + both + nlos          # received: direct, direct + reflection, NLOS
         assert blocked > direct                       # a 20 m x 60 m canyon hides most of the sky
     assert (tmp_path / "sky.png").stat().st_size > 5000
     open_sky = run_cli(["sky", *SITE, "--hours", "1", "--step", "900"], tmp_path)
-    n_open = [int(ln.split()[4]) for ln in open_sky.stdout.splitlines() if ln.startswith("2026-04-27")]
+    n_open = [int(ln.split()[_all_column(open_sky.stdout)]) for ln in open_sky.stdout.splitlines()
+              if ln.startswith("2026-04-27")]
     assert all(int(r[-4]) + int(r[-3]) + int(r[-2]) + int(r[-1]) == n for r, n in zip(rows, n_open))
 
 
