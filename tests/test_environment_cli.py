@@ -51,7 +51,7 @@ def test_sky_environment_bad_input(tmp_path):
 @pytest.fixture(scope="module")
 def urban(tmp_path_factory):
     return simkit.run("urban_canyon", out=tmp_path_factory.mktemp("ucli") / "u.h5",
-                      overrides={"scenario.duration_s": 60.0})
+                      overrides={"scenario.duration_s": 60.0, "gnss.truth_errors.model": "none"})  # the canyon alone
 
 
 def test_plot_draws_the_line_of_sight_figure(urban):
