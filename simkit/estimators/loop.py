@@ -2,7 +2,12 @@
 each update, loosely coupled position/velocity updates at the GNSS epochs, GNSS attitude updates, closed-loop
 feedback (the error state is reset to zero after each correction); measurements that fall on sample 0 (the initial
 epoch) are applied before the first step. ``mode`` 0 = Kalman, 1 = H-infinity with Wu's
-gamma rule, 2 = H-infinity with the weighted gamma rule."""
+gamma rule, 2 = H-infinity with the weighted gamma rule.
+
+The type of :func:`run`'s ``hinf`` argument, not its value, picks the correction: numba prunes the ``hinf is None``
+branch at compile time, so the Kalman loop does not compile the H-infinity correction (its eigenvalue and existence
+kernels: a quarter of the loop's cold compile), and each of the two loops is one specialisation.
+"""
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -173,13 +178,7 @@ def run(imu, nav0, tuning, gnss, att, dd, out, hinf):
     velocity with w_ib[s], H's lever rows use the trailing mean w_mean: :func:`_pv_rows`) from ``nav0``
     (:class:`Nav`) with ``tuning`` (:class:`Tuning`), position/velocity fixes ``gnss`` and attitude fixes ``att``
     (:class:`Fixes`) and the fixed DD carrier ``dd`` (:class:`DDRows`). Fills and returns ``out``
-    (:class:`Outputs`).
-
-    ``hinf``: None for the Kalman correction, True for the H-infinity one (``tuning.mode`` 1 or 2). Its type, not
-    its value, picks the correction: numba prunes the ``hinf is None`` branch at compile time, so the Kalman loop
-    does not compile the H-infinity correction (its eigenvalue and existence kernels, a quarter of the cold
-    compile) and each loop is one specialisation.
-    """
+    (:class:`Outputs`). ``hinf``: None (Kalman) or True (H-infinity, ``tuning.mode`` 1 or 2): see the module doc."""
     phi, dvb, dt, w_ib, w_mean = imu
     c, v, pos, bg, ba, lever = nav0
     p, qc, cov_dt, mode, alpha = tuning
@@ -219,10 +218,7 @@ def run(imu, nav0, tuning, gnss, att, dd, out, hinf):
                 r = gr[ig]
             else:
                 continue
-            if hinf is None:
-                res = _kalman(p, nu, h, r, alpha, False)
-            else:
-                res = _hinf(p, nu, h, r, alpha, mode == 2)
+            res = _kalman(p, nu, h, r, alpha, False) if hinf is None else _hinf(p, nu, h, r, alpha, mode == 2)
             gated = kind == 1 and not res[2] <= dd.gate[idd]  # DD innovation gate (inf: off): state kept
             if not gated:
                 p = res[1]
