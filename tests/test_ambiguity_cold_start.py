@@ -137,3 +137,23 @@ def test_in_cache_is_false_for_uncached_kernels():
     assert not in_cache(f, (typeof(1.0),))
     sig = tuple(typeof(v) for v in (np.zeros(3, np.float32), np.eye(3, dtype=np.float32), 2, 10))
     assert not in_cache(search._ils_kernel, sig)  # never compiled for float32
+
+
+def test_the_attitude_progress_line_names_a_kernel_running_interpreted(capsys):
+    """While a background compile runs, the attitude progress bar says which kernel answers interpreted."""
+    from numba import njit
+
+    from simkit.ambiguity import warmup
+    from simkit.attitude.solvers import _progress
+
+    j = warmup.jit_when_ready(njit(lambda x: x), lambda x: 1, 40)
+    j._thread = object()  # a compile under way: started, not finished
+    try:
+        assert list(_progress([1, 2, 3], True, "attitude (lambda)")) == [1, 2, 3]
+        assert "<lambda>: interpreted while numba compiles it" in capsys.readouterr().err
+        j._ready.set()  # finished: the note goes
+        list(_progress([1, 2], True, "attitude (lambda)"))
+        assert "interpreted" not in capsys.readouterr().err
+    finally:
+        j._ready.set()
+        warmup._ALL.remove(j)
