@@ -6,10 +6,13 @@ install); "warm" = the same directory once a process has compiled and cached the
 - first ils: the first call (n = 10, a GNSS-like problem); cold, it runs the kernel interpreted while numba
   compiles in the background (simkit/ambiguity/warmup.py);
 - compiled after: from the first call until the compiled kernel is in use (compilation, or the cache load);
-- quickstart: wall time of `python -m simkit run quickstart -o <tmp>` (other stages compile their own kernels;
-  reported, not a target). Medians over --repeat runs.
+- quickstart: `python -m simkit run quickstart -o <tmp>` (other stages compile their own kernels);
+- solve: `python -m simkit solve <that file>` (spp and kf15: the Kalman filter loop's compile);
+  wall and CPU (user + sys of the child, the figure to compare on a loaded machine) for both. Medians over
+  --repeat runs; the load average is printed with the table.
 """
 import argparse
+import resource
 import json
 import os
 import shutil
@@ -52,13 +55,24 @@ def first_ils(cache_dir):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def _timed(args, cache_dir):
+    """(wall s, CPU s) of ``python -m simkit ARGS`` in a fresh interpreter (CPU: the child's user + sys)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "simkit", *args], env=_env(cache_dir), capture_output=True, check=True,
+                   timeout=1200)
+    wall, after = time.perf_counter() - t, resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
 def quickstart(cache_dir):
-    """Wall time (s) of `python -m simkit run quickstart -o <tmp>` in a fresh interpreter."""
+    """{quickstart, quickstart_cpu, solve, solve_cpu} (s): `simkit run quickstart`, then `simkit solve` on its
+    file, each in a fresh interpreter."""
     with tempfile.TemporaryDirectory() as tmp:
-        t = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "simkit", "run", "quickstart", "-o", str(Path(tmp) / "q.h5")],
-                       env=_env(cache_dir), capture_output=True, check=True, timeout=1200)
-        return time.perf_counter() - t
+        h5 = str(Path(tmp) / "q.h5")
+        run = _timed(["run", "quickstart", "-o", h5], cache_dir)
+        solve = _timed(["solve", h5], cache_dir)
+    return {"quickstart": run[0], "quickstart_cpu": run[1], "solve": solve[0], "solve_cpu": solve[1]}
 
 
 def _median(xs):
@@ -76,8 +90,8 @@ def measure(repeat=3):
             warm = first_ils(cache)
             shutil.rmtree(cache)
             cache.mkdir()
-            cold["quickstart"] = quickstart(cache)
-            warm["quickstart"] = quickstart(cache)
+            cold.update(quickstart(cache))
+            warm.update(quickstart(cache))
         finally:
             shutil.rmtree(cache, ignore_errors=True)
         rows["cold"].append(cold)
@@ -89,10 +103,12 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     rows = measure(ap.parse_args().repeat)
-    print(f"{'numba cache':<12} {'import s':>9} {'first ils s':>12} {'compiled after s':>17} {'quickstart s':>13}")
+    print(f"{'numba cache':<12} {'import s':>9} {'first ils s':>12} {'compiled after s':>17} {'quickstart s':>13} "
+          f"{'(CPU s)':>8} {'solve s':>8} {'(CPU s)':>8}")
     for r in rows:
         print(f"{r['state']:<12} {r['import']:>9.2f} {r['first_ils']:>12.3f} {r['compiled_after']:>17.2f} "
-              f"{r['quickstart']:>13.1f}")
+              f"{r['quickstart']:>13.1f} {r['quickstart_cpu']:>8.1f} {r['solve']:>8.1f} {r['solve_cpu']:>8.1f}")
+    print(f"load average (1 min) at the end: {os.getloadavg()[0]:.1f}")
 
 
 if __name__ == "__main__":

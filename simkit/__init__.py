@@ -1,7 +1,10 @@
 """simkit: multi-antenna GNSS/INS simulation with exact truth, and the tools that check what consumes it."""
 from __future__ import annotations
 
+from . import jitcache
 from .version import __version__
+
+jitcache.choose()  # before any numba kernel is defined: a read-only install still caches them
 
 __all__ = ["__version__", "campaign", "open", "run", "score", "solve", "validate"]
 

@@ -94,19 +94,19 @@ def check_solve(path, filters=None, params=None) -> dict:
     return shares
 
 
-def kernels_cold() -> bool:
-    """True when a numba kernel of the filter loop (:mod:`simkit.estimators.loop`, which compiles the Kalman and
-    H-infinity kernels it calls) has no valid on-disk cache yet: its first use compiles it, ~40 s of CPU. Reads
-    numba's cache index; False when numba's layout is not the expected one."""
-    from numba.core.dispatcher import Dispatcher
-
+def kernels_cold(filters=None) -> bool:
+    """True when a filter loop that ``filters`` (default: :func:`solve`'s) run has no valid on-disk cache yet:
+    its first use compiles it, ~30 s of CPU. The Kalman and the H-infinity loops are two specialisations of
+    :func:`simkit.estimators.loop.run` (its ``hinf`` argument is None or a bool). Reads numba's cache index; False
+    when numba's layout is not the expected one."""
     from .estimators import loop
 
-    kernels = [f for f in vars(loop).values() if isinstance(f, Dispatcher)]
+    wanted = {"bool" if n == "hinf" else "none" for n in set(check_filters(filters)) & set(KERNEL_FILTERS)}
     try:
-        return any(not f._cache._cache_file._load_index() for f in kernels)
-    except (AttributeError, OSError):
+        cached = {str(key[0][-1]) for key in loop.run._cache._cache_file._load_index()}
+    except (AttributeError, OSError, EOFError, ValueError, IndexError, TypeError):
         return False
+    return not wanted <= cached
 
 
 def _solve_one(path, solver, share, progress):
@@ -145,7 +145,7 @@ def solve(path, filters=None, params=None, progress: bool = False, on_each=None)
     report = on_each or _warn_failure
     out = {}
     with tqdm(total=len(filters), unit="filter", desc="solve", leave=False, disable=not progress) as bar:
-        if progress and any(n in KERNEL_FILTERS for n in filters) and kernels_cold():
+        if progress and kernels_cold(filters):
             bar.write("solve: compiling the filter kernels (first run only, cached)", file=sys.stderr)
         for name in filters:
             bar.set_postfix_str(name)

@@ -104,7 +104,7 @@ def _batch_solver(leaf_cost):
     """The constrained batch solver for one leaf cost (:func:`length_leaf` or :func:`attitude_leaf`)."""
     search = make_search(leaf_cost)
 
-    @njit
+    @njit(inline="always")  # one call site; see the note above the entry kernels
     def solve_epoch(ep, F, lengths, max_nodes, best, cands, ratio_stop):
         """Decorrelate, then search-and-expand: a first leaf far off the constraint would make search-and-shrink
         start from a huge ellipsoid, so search below chi2 and expand it until m candidates are inside (then
@@ -133,7 +133,7 @@ def _batch_solver(leaf_cost):
         cands[:, :] = back_transform(best.cands, w.Zti, w.shift)
         return status, 0, 0, total
 
-    @njit
+    @njit(inline="always")
     def solve_batch(eps, F, lengths, m, max_nodes, k_out, ratio_stop):
         """Every epoch of the stacked ``eps``, ``lengths`` (K, r): (cands, costs, sols, status, nodes, err)."""
         K, n = eps.a_hat.shape
@@ -161,6 +161,9 @@ _solve_attitude = _batch_solver(attitude_leaf)
 
 
 # One cached entry kernel per constraint, so that each compiles (and loads) only its own inner problem.
+# solve_batch and solve_epoch are inlined into it (numba IR inlining, one call site each): as separate functions
+# each was compiled into its own LLVM module and optimised again inside every caller's linked module, and the
+# first attitude_mc solve took 39.5 s of CPU instead of 29.8 s (docs/cold_start.md).
 @njit(cache=True)
 def _length_batch(eps, F, lengths, m, max_nodes, ratio_stop):
     return _solve_length(eps, F, lengths, m, max_nodes, 3, ratio_stop)

@@ -8,9 +8,12 @@ interpreter: :func:`interpreted` rebuilds a jitted function with every jitted fu
 globals or closure cells) replaced by its interpreted twin. That takes milliseconds for the problem sizes GNSS
 gives (n <= 20: 1-25 ms here), and gives the same numbers (no fastmath, same operations in the same order).
 
-:class:`JitWhenReady` starts the compilation (or the cache load, 0.2 s when warm) in a daemon thread at the first
-call and answers with the interpreted twin until it is done; problems above ``max_interpreted_n`` wait for the
-compiled kernel instead. One implementation, two ways to run it.
+:class:`JitWhenReady` looks in numba's on-disk cache at the first call: when the kernel is there for the call's
+types, it loads it in the caller's thread (~0.2 s) and every call runs compiled. Only when a real compilation is
+due does it start one in a daemon thread and answer with the interpreted twin until it is done (loading a warm
+cache in the background instead left ils interpreted, ~100x slower, for the seconds the thread took to get the
+GIL); problems above ``max_interpreted_n`` wait for the compiled kernel instead. :func:`compiling` names the
+kernels being compiled, for a progress line. One implementation, two ways to run it.
 """
 from __future__ import annotations
 
@@ -42,6 +45,18 @@ def interpreted(fn, _memo=None):
 
 def _twin_of(value, memo):
     return interpreted(value, memo) if isinstance(value, Dispatcher) else value
+
+
+def in_cache(kernel, sig) -> bool:
+    """True when numba's on-disk cache holds ``kernel`` compiled for the types ``sig`` and for this source (the
+    same index lookup as numba's own cache load, without loading the machine code). False when numba's cache
+    layout is not the expected one: the caller then compiles in the background, which is slower but right."""
+    try:
+        cache = kernel._cache
+        key = cache._index_key(sig, kernel.targetctx.codegen())
+        return key in cache._cache_file._load_index()
+    except (AttributeError, OSError, EOFError, ValueError):
+        return False
 
 
 class JitWhenReady:
@@ -81,9 +96,21 @@ class JitWhenReady:
         if self._thread is not None:
             self._ready.wait()
 
+    def compiling(self) -> bool:
+        """True while the background compilation runs (the interpreted twin answers meanwhile)."""
+        return self._thread is not None and not self._ready.is_set()
+
     def _warming_up(self, *args):
         if self._ready.is_set():
             return self.kernel(*args)
+        with self._lock:
+            if self._thread is None and not self.kernel.signatures:
+                sig = tuple(typeof(a) for a in args)
+                if in_cache(self.kernel, sig):  # a cache load, not a compile: done here, compiled from call 1
+                    self.kernel.compile(sig)
+                    self.call = self.kernel
+                    self._ready.set()
+                    return self.kernel(*args)
         self.start(*args)
         if self.size(*args) > self.max_interpreted_n:
             self._ready.wait()
@@ -94,6 +121,11 @@ class JitWhenReady:
 
 
 _ALL: list[JitWhenReady] = []
+
+
+def compiling() -> list[str]:
+    """Names of the kernels numba is compiling in the background right now (their interpreted twins answer)."""
+    return [j.kernel.__name__ for j in _ALL if j.compiling()]
 
 
 def jit_when_ready(kernel, size, max_interpreted_n) -> JitWhenReady:

@@ -20,10 +20,23 @@ SOLVER_NAMES = tuple(_METHOD)
 
 
 def _progress(items, progress, desc):
+    """``items`` with a progress bar that says when a kernel runs interpreted while numba compiles it."""
     if not progress:
-        return items
+        yield from items
+        return
     from tqdm import tqdm
-    return tqdm(items, desc=desc, unit="group")
+
+    from ..ambiguity.warmup import compiling
+
+    with tqdm(items, desc=desc, unit="group") as bar:
+        shown = ""
+        for item in bar:
+            names = compiling()
+            note = f"{', '.join(names)}: interpreted while numba compiles it" if names else ""
+            if note != shown:
+                bar.set_postfix_str(note)
+                shown = note
+            yield item
 
 
 def body_baselines(lever_arm: np.ndarray) -> np.ndarray:

@@ -180,9 +180,10 @@ class _LooselyCoupled:
         darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p), first)
         out = loop.allocate(idx.size, n, aarr.k.size, darr.k.size)
         w_mean = window_mean_rate(comp, int(round(cfg.lever_rate_window_s / float(np.median(comp.dt)))))
-        tuning = loop.Tuning(_p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), self._mode(),
-                             float(cfg.alpha))
-        loop.run(loop.Samples(comp.phi, comp.dvb, comp.dt, comp.w_ib, w_mean), nav0, tuning, garr, aarr, darr, out)
+        mode = self._mode()
+        tuning = loop.Tuning(_p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), mode, float(cfg.alpha))
+        loop.run(loop.Samples(comp.phi, comp.dvb, comp.dt, comp.w_ib, w_mean), nav0, tuning, garr, aarr, darr, out,
+                 None if mode == 0 else True)
         sol = self._solution(imu.t[garr.k], out)
         return _with_dd(sol, garr.k, darr, out.dd_nis) if self.uses_dd else sol
 

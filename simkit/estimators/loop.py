@@ -2,7 +2,12 @@
 each update, loosely coupled position/velocity updates at the GNSS epochs, GNSS attitude updates, closed-loop
 feedback (the error state is reset to zero after each correction); measurements that fall on sample 0 (the initial
 epoch) are applied before the first step. ``mode`` 0 = Kalman, 1 = H-infinity with Wu's
-gamma rule, 2 = H-infinity with the weighted gamma rule."""
+gamma rule, 2 = H-infinity with the weighted gamma rule.
+
+The type of :func:`run`'s ``hinf`` argument, not its value, picks the correction: numba prunes the ``hinf is None``
+branch at compile time, so the Kalman loop does not compile the H-infinity correction (its eigenvalue and existence
+kernels: a quarter of the loop's cold compile), and each of the two loops is one specialisation.
+"""
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -103,11 +108,17 @@ def _feedback(x, c, v, pos, bg, ba, lever):
 
 
 @njit(cache=True)
-def _kalman(p, nu, h, r):
+def _kalman(p, nu, h, r, alpha, weighted):
     """The Kalman correction of the zero error state, as the H-infinity correction's 7-tuple (x, P, nis, w,
-    gamma NaN, margin NaN, status)."""
+    gamma NaN, margin NaN, status); ``alpha`` and ``weighted`` unused (the H-infinity signature)."""
     x, p, nis, w, status = kalman.correct(np.zeros(p.shape[0]), p, nu, h, r)
     return x, p, nis, w, np.nan, np.nan, status
+
+
+@njit(cache=True)
+def _hinf(p, nu, h, r, alpha, weighted):
+    """The H-infinity correction of the zero error state (:func:`.kalman.correct_hinf`)."""
+    return kalman.correct_hinf(np.zeros(p.shape[0]), p, nu, h, r, alpha, weighted)
 
 
 @njit(cache=True)
@@ -162,11 +173,12 @@ def allocate(m, n, k_att, k_dd) -> Outputs:
 
 
 @njit(cache=True)
-def run(imu, nav0, tuning, gnss, att, dd, out):
-    """The recursion over the compensated IMU ``imu`` (:class:`Samples`; a fix at sample s predicts its lever velocity
-    with w_ib[s], H's lever rows use the trailing mean w_mean: :func:`_pv_rows`) from ``nav0`` (:class:`Nav`)
-    with ``tuning`` (:class:`Tuning`), position/velocity fixes ``gnss`` and attitude fixes ``att``
-    (:class:`Fixes`) and the fixed DD carrier ``dd`` (:class:`DDRows`). Fills ``out`` (:class:`Outputs`)."""
+def run(imu, nav0, tuning, gnss, att, dd, out, hinf):
+    """The recursion over the compensated IMU ``imu`` (:class:`Samples`; a fix at sample s predicts its lever
+    velocity with w_ib[s], H's lever rows use the trailing mean w_mean: :func:`_pv_rows`) from ``nav0``
+    (:class:`Nav`) with ``tuning`` (:class:`Tuning`), position/velocity fixes ``gnss`` and attitude fixes ``att``
+    (:class:`Fixes`) and the fixed DD carrier ``dd`` (:class:`DDRows`). Fills and returns ``out``
+    (:class:`Outputs`). ``hinf``: None (Kalman) or True (H-infinity, ``tuning.mode`` 1 or 2): see the module doc."""
     phi, dvb, dt, w_ib, w_mean = imu
     c, v, pos, bg, ba, lever = nav0
     p, qc, cov_dt, mode, alpha = tuning
@@ -175,7 +187,7 @@ def run(imu, nav0, tuning, gnss, att, dd, out):
     dk = dd.k
     v_prev = v.copy()
     fsum, tacc = np.zeros(3), 0.0
-    ig, ia, idd = 0, 0, 0
+    ig, ia, idd = np.int64(0), np.int64(0), np.int64(0)  # typed int64: a literal 0 would add specialisations
     for s in range(dt.size + 1):  # sample s; interval k = s - 1 leads to it (sample 0: the initial epoch)
         k = max(s - 1, 0)
         ph = phi[k] - bg * dt[k]
@@ -206,9 +218,8 @@ def run(imu, nav0, tuning, gnss, att, dd, out):
                 r = gr[ig]
             else:
                 continue
-            res = kalman.correct_hinf(np.zeros(p.shape[0]), p, nu, h, r, alpha, mode == 2) if mode >= 1 else \
-                _kalman(p, nu, h, r)
-            gated = kind == 1 and not res[2] <= dd.gate[idd]  # DD innovation gate (inf: off): state left alone
+            res = _kalman(p, nu, h, r, alpha, False) if hinf is None else _hinf(p, nu, h, r, alpha, mode == 2)
+            gated = kind == 1 and not res[2] <= dd.gate[idd]  # DD innovation gate (inf: off): state kept
             if not gated:
                 p = res[1]
                 c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
