@@ -25,7 +25,7 @@ from datetime import date
 import numpy as np
 
 from .. import gpstime
-from ..constellation.textfile import read_bytes
+from ..constellation.textfile import number, read_bytes
 from ..errors import DataFileError, InputError
 from . import signals as sigmod
 
@@ -117,18 +117,6 @@ def signal_name(system: str, code: str, version: float) -> str | None:
     return None
 
 
-def _num(text, path, line, what, blank=None):
-    s = text.strip()
-    if not s:
-        if blank is None:
-            raise DataFileError(path, f"missing {what}", line)
-        return blank
-    try:
-        return float(s.replace("D", "E"))
-    except ValueError:
-        raise DataFileError(path, f"expected a number for {what}, found {s!r}", line) from None
-
-
 def _v2_code(sys: str, code: str, version: float) -> str:
     """A RINEX 2 observation type as a RINEX 3 code (systems other than GPS: the band digit and attribute X)."""
     if sys == "G":
@@ -148,7 +136,7 @@ def read_header(lines, path):
     if kind != "O":
         what = "a navigation file" if kind in "NGHLC" and kind.strip() else f"type {kind.strip() or 'blank'}"
         raise DataFileError(path, f"is {what}, expected a RINEX observation file (type 'O' in column 21)", 1)
-    version = _num(first[:9], path, 1, "RINEX version")
+    version = number(first[:9], path, 1, "RINEX version", None)
     if not (2.10 <= version < 2.2 or 3.0 <= version < 3.1 or 4.0 <= version < 4.1):
         raise DataFileError(path, f"RINEX version {version:g} is not supported (2.10, 2.11, 3.0x or 4.00)", 1)
     state = _HeaderState(path, version, first[40:41].strip() or "G")
@@ -185,21 +173,21 @@ class _HeaderState:
         elif label == "ANT # / TYPE":
             info["antenna"] = line[20:40].strip()
         elif label == "APPROX POSITION XYZ":
-            pos = np.array([_num(line[14 * k:14 * k + 14], path, i, "APPROX POSITION XYZ coordinate")
+            pos = np.array([number(line[14 * k:14 * k + 14], path, i, "APPROX POSITION XYZ coordinate", None)
                             for k in range(3)])
             info["pos"] = pos if np.linalg.norm(pos) > 0 else None  # 0,0,0 means unknown
         elif label == "ANTENNA: DELTA H/E/N":
-            info["delta"] = np.array([_num(line[14 * k:14 * k + 14], path, i, "antenna delta", 0.0)
+            info["delta"] = np.array([number(line[14 * k:14 * k + 14], path, i, "antenna delta", 0.0)
                                       for k in range(3)])
         elif label == "INTERVAL":
-            info["interval"] = _num(line[:10], path, i, "INTERVAL", None)
+            info["interval"] = number(line[:10], path, i, "INTERVAL", None)
         elif label == "TIME OF FIRST OBS":
             info["tsys"] = line[48:51].strip()
         elif label == "RCV CLOCK OFFS APPL":
-            info["applied"] = _num(line[:6], path, i, "RCV CLOCK OFFS APPL", 0.0) == 1
+            info["applied"] = number(line[:6], path, i, "RCV CLOCK OFFS APPL", 0.0) == 1
         elif label == "# / TYPES OF OBSERV" and self.version < 3:
             if line[:6].strip():
-                self.n_v2 = int(_num(line[:6], path, i, "number of observation types"))
+                self.n_v2 = int(number(line[:6], path, i, "number of observation types", None))
             elif self.n_v2 is None:
                 raise DataFileError(path, "'# / TYPES OF OBSERV' continuation line before its first line", i)
             self.v2_types += line[6:60].split()
@@ -210,7 +198,7 @@ class _HeaderState:
         sys = line[0:1]
         if sys.strip():
             self._check_pending(i)
-            self.pending = (sys, int(_num(line[3:6], self.path, i, "number of observation types")))
+            self.pending = (sys, int(number(line[3:6], self.path, i, "number of observation types", None)))
             self.types[sys] = []
         elif self.pending is None:
             raise DataFileError(self.path, "'SYS / # / OBS TYPES' continuation line before its first line", i)
@@ -304,7 +292,7 @@ class _Walker:
         if not text.strip():
             return np.nan
         self.note("receiver clock offset in epoch lines", i + 1)
-        return _num(text, self.path, i + 1, "receiver clock offset")
+        return number(text, self.path, i + 1, "receiver clock offset", None)
 
     def _special(self, i, flag, count) -> int:
         """Skip the ``count`` special records of an event epoch (flags 2-5) or cycle-slip records (flag 6)."""
@@ -322,6 +310,14 @@ class _Walker:
                                     f"{flag}): not supported, split the file there", i + 2 + k)
         return i + 1 + count
 
+    def _open_epoch(self, i, t, flag, clock_text) -> int:
+        """Record the epoch of line ``i`` (flag 0 or 1) and its receiver clock field; returns its index."""
+        if flag == 1:
+            self.note("epoch flag 1 (power failure since the previous epoch)", i + 1)
+        self.times.append(t)
+        self.clocks.append(self._clock(clock_text, i))
+        return len(self.times) - 1
+
     def _epoch3(self, i):
         line = self.lines[i]
         if line[0] != ">":
@@ -329,11 +325,7 @@ class _Walker:
         t, flag, count = self._epoch_fields(line, i, True)
         if flag >= 2:
             return self._special(i, flag, count)
-        if flag == 1:
-            self.note("epoch flag 1 (power failure since the previous epoch)", i + 1)
-        k = len(self.times)
-        self.times.append(t)
-        self.clocks.append(self._clock(line[41:56], i))
+        k = self._open_epoch(i, t, flag, line[41:56])
         for j in range(i + 1, i + 1 + count):
             if j >= len(self.lines):
                 raise DataFileError(self.path, f"epoch announces {count} satellites, the file ends after "
@@ -352,11 +344,7 @@ class _Walker:
         t, flag, count = self._epoch_fields(line, i, False)
         if flag >= 2:
             return self._special(i, flag, count)
-        if flag == 1:
-            self.note("epoch flag 1 (power failure since the previous epoch)", i + 1)
-        k = len(self.times)
-        self.times.append(t)
-        self.clocks.append(self._clock(line[68:80], i))
+        k = self._open_epoch(i, t, flag, line[68:80])
         sats, j = [], i
         while len(sats) < count:
             text = self.lines[j][32:68] if j < len(self.lines) else ""
