@@ -115,7 +115,7 @@ def _position(code, sat, sys_onehot, mask_rad, sigma, iterations, delays):
     coarse = np.arange(0, m, COARSE)
     xc, _, _, used, _, ok = _iterate(code[coarse], sat[coarse], sys_onehot, mask_rad, sigma, iterations,
                                      delays.rows(coarse), 0)
-    good = np.flatnonzero(ok & (used.sum(1) >= 3 + (sys_onehot[None] * used[..., None]).any(1).sum(1)))
+    good = np.flatnonzero(_enough(ok, used, sys_onehot))
     x0 = np.zeros((m, xc.shape[1]))
     if good.size:
         nearest = np.clip(np.searchsorted(coarse[good], np.arange(m) - COARSE // 2), 0, good.size - 1)
@@ -124,6 +124,12 @@ def _position(code, sat, sys_onehot, mask_rad, sigma, iterations, delays):
 
 
 COARSE = 60
+
+
+def _enough(ok, used, sys_onehot):
+    """(M,) bool: a regular fix with at least as many satellites ``used`` (M, S) as unknowns (3 + the clocks of the
+    systems seen at the epoch)."""
+    return ok & (used.sum(1) >= 3 + (sys_onehot[None] * used[..., None]).any(1).sum(1))
 
 
 def _iterate(code, sat, sys_onehot, mask_rad, sigma, iterations, delays, first, x=None):
@@ -197,7 +203,7 @@ def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, grou
     x, e, el, used, ninv, ok = _position(corrected, sat, onehot, np.radians(elevation_mask_deg), sigma_code_m,
                                          iterations, _delays(systems, wavelength_m, iono_coefficients, gps_sow, m))
     n_used = used.sum(1)
-    good = ok & (n_used >= 3 + (onehot[None] * used[..., None]).any(1).sum(1))
+    good = _enough(ok, used, onehot)
     x[~good] = np.nan
     vel, vcov = _velocity(t, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, x[:, :3], e, el,
                           used & good[:, None], sigma_doppler_m_per_s)

@@ -29,10 +29,10 @@ class Record:
     def track(self, week0: int, sow0: float, t_min: float, t_max: float) -> Track:
         """The samples within [t_min, t_max] s of the GPS epoch (week0, sow0), times relative to it."""
         t = gpstime.diff_seconds(self.week, self.sow, week0, sow0)
-        keep = np.nonzero((t >= t_min) & (t <= t_max))[0]
-        f = lambda a: None if a is None else np.asarray(a, float)[keep]
-        return Track(t[keep], np.asarray(self.pos_ecef, float)[keep], np.asarray(self.line)[keep], self.source,
-                     f(self.sigma_enu), f(self.vel_enu), f(self.sigma_vel), f(self.euler))
+        f = lambda a: None if a is None else np.asarray(a, float)
+        full = Track(t, f(self.pos_ecef), np.asarray(self.line), self.source, f(self.sigma_enu), f(self.vel_enu),
+                     f(self.sigma_vel), f(self.euler))
+        return full.take(np.nonzero((t >= t_min) & (t <= t_max))[0])
 
     def span_text(self) -> str:
         """The log's first and last epoch in UTC (for messages)."""

@@ -189,10 +189,14 @@ class LoggedPath:
             self._fit_attitude(track, opts)
         else:
             grid = np.linspace(0.0, duration_s, max(2, int(np.ceil(duration_s / min(spacing, 0.1))) + 1))
-            if self.rule == "ground" and self._slowest(grid)[0] < MIN_SPEED_M_PER_S:
+            vmin, k = self._slowest(grid)
+            if vmin < MIN_SPEED_M_PER_S and self.rule == "ground":
                 self._hold_through_stops(track.t, opts)
-            else:
-                self._check_motion(grid)
+            elif vmin < MIN_SPEED_M_PER_S:   # the coordinated rule banks by the turn rate: no direction, no bank
+                raise DataFileError(self.source, f"the fitted path slows to {vmin:.2f} m/s at {grid[k]:.1f} s: "
+                                                 f"attitude rule {self.rule!r} needs a horizontal speed of at "
+                                                 f"least {MIN_SPEED_M_PER_S:g} m/s (give attitude in the log, or "
+                                                 f"select a moving part with scenario.start / duration_s)")
 
     def _local_velocity(self, track: Track, opts: FitOptions):
         """Logged velocities in L and their sigmas (K, 3), or (None, None) when absent or of unknown accuracy."""
@@ -251,16 +255,6 @@ class LoggedPath:
         sigma = HELD_SIGMA_RAD * np.where(moving, np.maximum(1.0, HELD_SPEED_M_PER_S / np.maximum(vh, 1e-9)), 1.0)
         self.att_splines = [pspline.smooth(self.knots, t, angles[:, i], sigma)[0] for i in range(3)]
         self.held_epochs = int((~moving).sum())
-
-    def _check_motion(self, grid):
-        """The velocity-following rules need a direction of motion throughout the run."""
-        vmin, k = self._slowest(grid)
-        if vmin < MIN_SPEED_M_PER_S:
-            vh = np.full(len(grid), vmin)
-            raise DataFileError(self.source, f"the fitted path slows to {vh[k]:.2f} m/s at {grid[k]:.1f} s: "
-                                             f"attitude rule {self.rule!r} needs a horizontal speed of at least "
-                                             f"{MIN_SPEED_M_PER_S:g} m/s (give attitude in the log, or select a "
-                                             f"moving part with scenario.start / duration_s)")
 
     def summary(self) -> dict:
         """What the fit used and found (the ``log`` attribute of /truth): rule, sigmas and their source, residual
