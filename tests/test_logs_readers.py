@@ -213,6 +213,7 @@ def test_bad_log_is_one_line(tmp_path, case):
     ('attitude = "log"\n', "has no attitude"),
     ('position_sigma_m = [1.0, 2.0]\n', "trajectory.position_sigma_m"),
     ('attitude = "banked"\n', "trajectory.attitude: must be one of"),
+    ('outliers = "ignore"\n', "trajectory.outliers: must be one of"),
 ])
 def test_bad_keys_beside_source(tmp_path, extra, expect):
     t, lat, lon, h = _good_nmea()

@@ -74,6 +74,8 @@ def test_a_resolve_replaces_only_its_own_group(small):
     (["--filter", "kf15", "--set", "estimator.elevation_mask_deg=true"],
      "estimator.elevation_mask_deg: expected a number, got True"),
     (["--filter", "spp", "--set", "estimator.antenna=1.5"], "estimator.antenna: expected an integer, got 1.5"),
+    (["--filter", "spp", "--set", "estimator.systems='GX'"], "estimator.systems: expected distinct letters of G, C"),
+    (["--filter", "spp", "--set", "estimator.systems='GG'"], "estimator.systems: expected distinct letters of G, C"),
     (["--filter", "tdcp", "--set", "estimator.antenna=1.0"], "estimator.antenna: expected an integer, got 1.0"),
     (["--filter", "tdcp", "--set", "estimator.antenna=2"], "estimator.antenna: expected 0 .. 1 ("),
     (["--filter", "attitude", "--set", "estimator.every=2.0"], "estimator.every: expected an integer, got 2.0"),
