@@ -97,31 +97,48 @@ def check(track: Track, opts: FitOptions) -> None:
                                  f"select a part of the log with scenario.start / duration_s", int(track.line[k + 1]))
 
 
-def _jumps(track: Track, opts: FitOptions, sigma_m) -> np.ndarray:
-    """Indices k of the steps k -> k + 1 faster than ``max_speed_m_per_s`` plus 6 sigma of noise on some local
-    axis (E, N, U at the first sample; ``sigma_m`` a scalar or per axis (3,) m)."""
+def _enu_axes(track: Track) -> np.ndarray:
+    """ECEF -> local ENU rotation (3, 3) at the track's first sample: the axes of the jump test."""
     lla = frames.ecef_to_lla(track.pos_ecef[0])
-    step = np.abs(np.diff(track.pos_ecef, axis=0) @ frames.ecef_to_enu_matrix(lla[0], lla[1]).T)
-    allowed = opts.max_speed_m_per_s * np.diff(track.t)[:, None] + 6.0 * np.sqrt(2.0) * np.asarray(sigma_m, float)
+    return frames.ecef_to_enu_matrix(lla[0], lla[1])
+
+
+def _jumps(t, pos_ecef, c_enu, opts: FitOptions, sigma_m) -> np.ndarray:
+    """Indices k of the steps k -> k + 1 (times ``t`` s, positions (K, 3) m ECEF) faster than
+    ``max_speed_m_per_s`` plus 6 sigma of noise on some local axis (``c_enu`` ECEF -> ENU; ``sigma_m`` a scalar
+    or per axis (3,) m)."""
+    step = np.abs(np.diff(pos_ecef, axis=0) @ c_enu.T)
+    allowed = opts.max_speed_m_per_s * np.diff(t)[:, None] + 6.0 * np.sqrt(2.0) * np.asarray(sigma_m, float)
     return np.flatnonzero((step > allowed).any(axis=1))
+
+
+_JUMP_WINDOW = 512
 
 
 def drop_jumps(track: Track, opts: FitOptions, sigma_m) -> tuple[Track, np.ndarray]:
     """The track without its outlying samples, and their lines: while a step is too fast, of its two ends the one
-    farther from the median position of its 8 neighbours (4 either side, itself excluded) is dropped."""
-    dropped = []
-    while True:
-        bad = _jumps(track, opts, sigma_m)
+    farther from the median position of its 8 neighbours (4 either side, itself excluded) is dropped.
+
+    The steps are scanned in windows: dropping a sample changes only the step into its place, so the scan goes on
+    from the step before it, and a log with m outliers costs O(K + m * window), not O(K * m)."""
+    kept, dropped, p = np.arange(len(track.t)), [], 0      # steps before kept[p] are known to be good
+    c_enu = _enu_axes(track)
+    while p < len(kept) - 1:
+        seg = kept[p:p + _JUMP_WINDOW + 1]
+        bad = _jumps(track.t[seg], track.pos_ecef[seg], c_enu, opts, sigma_m)
         if bad.size == 0:
-            return track, np.asarray(dropped, dtype=np.int64)
-        k = int(bad[0])
+            p += _JUMP_WINDOW
+            continue
+        k = p + int(bad[0])
         dev = []
         for j in (k, k + 1):
-            near = np.r_[max(0, j - 4):j, j + 1:min(len(track.t), j + 5)]
-            dev.append(np.linalg.norm(track.pos_ecef[j] - np.median(track.pos_ecef[near], axis=0)))
+            near = kept[np.r_[max(0, j - 4):j, j + 1:min(len(kept), j + 5)]]
+            dev.append(np.linalg.norm(track.pos_ecef[kept[j]] - np.median(track.pos_ecef[near], axis=0)))
         j = k if dev[0] > dev[1] else k + 1
-        dropped.append(int(track.line[j]))
-        track = track.take(np.r_[0:j, j + 1:len(track.t)])
+        dropped.append(int(track.line[kept[j]]))
+        kept = np.delete(kept, j)
+        p = max(0, k - 1)
+    return track.take(kept), np.asarray(dropped, dtype=np.int64)
 
 
 def check_jumps(track: Track, opts: FitOptions, sigma_m) -> None:
@@ -129,7 +146,7 @@ def check_jumps(track: Track, opts: FitOptions, sigma_m) -> None:
     m per local axis) on some axis."""
     src, dt = track.source, np.diff(track.t)
     step = np.linalg.norm(np.diff(track.pos_ecef, axis=0), axis=1)
-    bad = _jumps(track, opts, sigma_m)
+    bad = _jumps(track.t, track.pos_ecef, _enu_axes(track), opts, sigma_m)
     if bad.size:
         k = int(bad[0])
         raise DataFileError(src, f"jump of {step[k]:.1f} m in {dt[k]:.3g} s ({step[k] / dt[k]:.0f} m/s) from line "
