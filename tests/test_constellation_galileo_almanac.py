@@ -8,39 +8,22 @@ ICD Table 70), t0a = the record's toe, wna = week mod 4. The almanac model drops
 as a receiver does; the referee is RTKLIB ``eph2pos`` with the broadcast record valid at each time (the latest
 I/NAV record with toe before t). The accuracy figure (printed with -s) is the almanac's, expected at the km level.
 """
-import gzip
 import math
-import shutil
 
 import numpy as np
 import pytest
 
 import pyrtklib
 from conftest import DATA
+from test_constellation_systems_rtklib import GPS_1980_UNIX, _rtklib_nav, _sat_id
 from simkit import gpstime
 from simkit.constellation import load
 from simkit.errors import DataFileError
 
 NAV = DATA / "rinex_nav" / "BRDM00DLR_S_20261170000_01D_MN.rnx.gz"
-GPS_1980_UNIX = 315964800
 T0A_SOW = 129600.0  # 2026-04-27 12:00 GPST (Monday; GPS week 2416 began on Sunday 2026-04-26)
 LSB = {"aSqRoot": 2 ** -9, "ecc": 2 ** -16, "deltai": 2 ** -14, "omega0": 2 ** -15, "omegaDot": 2 ** -33,
        "w": 2 ** -15, "m0": 2 ** -15, "af0": 2 ** -19, "af1": 2 ** -38}
-
-
-def _rtklib_nav(tmp_path):
-    plain = tmp_path / NAV.name.removesuffix(".gz")
-    with gzip.open(NAV) as fi, open(plain, "wb") as fo:
-        shutil.copyfileobj(fi, fo)
-    nav, obs, sta = pyrtklib.nav_t(), pyrtklib.obs_t(), pyrtklib.sta_t()
-    assert pyrtklib.readrnx(str(plain), 1, "", obs, nav, sta) == 1
-    return nav
-
-
-def _sat_id(sat):
-    buf = pyrtklib.Arr1Dchar(8)
-    pyrtklib.satno2id(sat, buf)
-    return buf[0]
 
 
 def _inav_records(nav):
@@ -85,7 +68,7 @@ def _gsc_xml(records, t0a_abs, issue="2026-04-27T09:47:00.0Z"):
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("gsc")
-    nav = _rtklib_nav(tmp)
+    nav = _rtklib_nav(NAV, tmp)
     records = _inav_records(nav)
     path = tmp / "2026-04-27.xml"
     path.write_text(_gsc_xml(records, 2416 * 604800.0 + T0A_SOW))
