@@ -190,8 +190,8 @@ def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, grou
     ...; None: no ionospheric correction) with ``gps_sow`` (M,) the epochs' GPS seconds of week.
     ``time_offset_s`` (M, S) s: broadcast system time minus GPS time of each satellite's system (Galileo GGTO, ...),
     added to the satellite clocks so they count GPS time; ``single_clock``: one receiver clock for every system
-    (``clock`` (M, 1), ``systems`` one string of the letters) instead of one per system, which absorbs the
-    offsets."""
+    (``clock`` (M, 1), ``systems`` one string of the letters) instead of one per system (per-system clocks absorb
+    the offsets; one clock needs them removed)."""
     t, code = np.asarray(t, float), np.asarray(code, float)
     m, s = code.shape
     doppler = np.full((m, s), np.nan) if doppler is None else np.asarray(doppler, float)
@@ -199,7 +199,10 @@ def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, grou
         raise SppInputError(f"spp: expected code/doppler (M, S), sat_pos_ecef (M, S, 3), sat_clock (M, S) "
                             f"with M={m}, S={s}; got {doppler.shape}, {sat_pos_ecef.shape}, {sat_clock_s.shape}")
     if time_offset_s is not None:
-        sat_clock_s = sat_clock_s + np.nan_to_num(np.asarray(time_offset_s, float))
+        time_offset_s = np.asarray(time_offset_s, float)
+        if time_offset_s.shape != (m, s):
+            raise SppInputError(f"spp: expected time_offset_s (M, S) with M={m}, S={s}; got {time_offset_s.shape}")
+        sat_clock_s = sat_clock_s + np.nan_to_num(time_offset_s)
     systems = np.asarray(systems)
     names = tuple(sorted(set(systems)))
     onehot = (systems[:, None] == np.array(names)[None, :]).astype(float)
