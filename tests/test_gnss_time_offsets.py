@@ -118,3 +118,16 @@ def test_spp_single_clock_removes_the_broadcast_offsets_per_system_clocks_absorb
     assert single.extras["n_sats"].min() >= 15
     assert e_per.max() < 0.005 and e_single.max() < 0.005
     assert np.median(e_biased) > 1.0
+
+
+def test_bad_clock_choice_is_one_line_exit_2(runs, tmp_path):
+    import subprocess
+    import sys
+
+    on, _ = runs
+    before = on.read_bytes()
+    run = subprocess.run([sys.executable, "-m", "simkit", "solve", str(on), "--filter", "spp", "--set",
+                          "estimator.clock='both'"], capture_output=True, text=True)
+    assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
+    assert "estimator.clock" in run.stderr and "per-system, single" in run.stderr
+    assert on.read_bytes() == before
