@@ -121,6 +121,15 @@ def test_week_from_issue_date_and_two_bit_wna(built, tmp_path):
     assert load(far).ref_week == 2420
 
 
+def test_a_default_namespace_reads_the_same(built, tmp_path):
+    path, _, _ = built
+    spaced = tmp_path / "ns.xml"
+    spaced.write_text(path.read_text().replace("<signalData>", '<signalData xmlns="urn:example:gsc">'))
+    a, b = load(path), load(spaced)
+    assert a.sat_ids == b.sat_ids
+    np.testing.assert_array_equal(a.records.params, b.records.params)
+
+
 def test_unhealthy_status_removes_the_satellite(built, tmp_path):
     path, _, _ = built
     text = path.read_text()

@@ -92,6 +92,9 @@ def read(path, raw: bytes, validity_days: float = DEFAULT_VALIDITY_DAYS) -> Kepl
     except ET.ParseError as exc:
         raise DataFileError(path, f"not well-formed XML (truncated?): {exc.msg if hasattr(exc, 'msg') else exc}",
                             exc.position[0]) from None
+    for node in root.iter():  # element names without a namespace, should a file declare one
+        if isinstance(node.tag, str) and "}" in node.tag:
+            node.tag = node.tag.split("}", 1)[1]
     week_issue = _issue_week(root, path, raw)
     svs = root.findall("./body/Almanacs/svAlmanac")
     if not svs:
