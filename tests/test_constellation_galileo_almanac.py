@@ -62,7 +62,8 @@ def _gsc_xml(records, t0a_abs, issue="2026-04-27T09:47:00.0Z"):
     </svAlmanac>""")
     return ("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<signalData>\n  <header><GAL-header>"
             f"<provider>simkit test (from BRDM 2026-04-27 I/NAV)</provider><issueDate>{issue}</issueDate>"
-            "</GAL-header></header>\n  <body><Almanacs>\n" + "\n".join(body) + "\n  </Almanacs></body>\n</signalData>\n")
+            "</GAL-header></header>\n  <body><Almanacs>\n" + "\n".join(body)
+            + "\n  </Almanacs></body>\n</signalData>\n")
 
 
 @pytest.fixture(scope="module")

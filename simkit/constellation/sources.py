@@ -36,8 +36,8 @@ def load(source, *, validity_days: float | None = None, systems: str | None = No
     ``nominal:gps+bds``, ``nominal:gal``, ``nominal:glo``, ``nominal:gps+bds+gal+glo``; a file path; a bundled
     file name; or ``almanac:<RINEX nav source>`` (an almanac derived
     from the broadcast records nearest the middle of the file, see :func:`almanac.from_ephemeris`). Files: RINEX 3.0x/4.00 navigation (plain or .gz),
-    YUMA or SEM GPS almanacs, GSC Galileo almanacs (XML), TLE sets (2- or 3-line). ``validity_days`` (almanac and TLE sources only) is the
-    span either side of the almanac/TLE epoch in which states are returned (default 7 days); broadcast
+    YUMA or SEM GPS almanacs, GSC Galileo almanacs (XML), TLE sets (2- or 3-line). ``validity_days`` (almanac and
+    TLE sources only) is the span either side of the almanac/TLE epoch in which states are returned (default 7 days); broadcast
     ephemerides always use their fit interval (GPS, QZSS +-2 h, BDS +-1 h, GLONASS +-30 min; Galileo the latest
     record before t, for 4 h).
     ``systems`` (RINEX navigation files only): the system letters to keep, e.g. ``"GC"`` (default: all of
