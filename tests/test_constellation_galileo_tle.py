@@ -95,3 +95,12 @@ def test_malformed_galileo_tle_is_one_line(tmp_path, edit, message):
     with pytest.raises(Exception) as info:
         load(bad)
     assert message in str(info.value) and str(bad) in str(info.value) and "\n" not in str(info.value)
+
+
+def test_validate_runs_on_the_galileo_tle_sky():
+    run = subprocess.run([sys.executable, "-m", "simkit", "validate", "quickstart", "--systems", "E", "--no-progress",
+                          "--set", f"gnss.constellation[0].source='{TLE}'",
+                          "--set", "scenario.start='2020-04-22T00:00:00Z'",
+                          "--set", 'gnss.signals=["L1C","B1I","E1C"]'], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "C4: held" in run.stdout and "C5: held" in run.stdout
