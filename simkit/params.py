@@ -76,6 +76,8 @@ SCHEMA: dict[str, Param] = {
     "systems": Param(str, "SPP: the systems used, letters of G, C, E, R, J ('' : every system of the file)",
                      lambda v: None if set(v) <= set("GCERJ") and len(set(v)) == len(v) else
                      "expected distinct letters of G, C, E, R, J (e.g. 'GC'), or ''"),
+    "clock": Param(str, "SPP receiver clocks: one per system, or one for all with the file's broadcast system-time "
+                   "offsets (/gnss/time_offset) removed", choices=("per-system", "single")),
     "truth_pos_sigma_m": Param(float, "gnss=truth: position noise E, N, U (m)", _list_check(NONNEG), shape=3),
     "truth_vel_sigma_m_per_s": Param(float, "gnss=truth: velocity noise (m/s)", POS),
     "seed": Param(int, "seed of the study noise (gnss=truth, attitude_source=truth)", NONNEG),

@@ -194,7 +194,7 @@ def gnss_rows(ep, prefix: str = "gnss/") -> dict[str, np.ndarray]:
 def gnss_static_rows(st, prefix: str = "gnss/") -> dict[str, np.ndarray]:
     """Dataset path -> array of :class:`simkit.gnss.GnssStatic`."""
     return {(f"{prefix}antennas/{f.name}" if f.name in ("lever_arm_b", "boresight_b") else f"{prefix}{f.name}"):
-            getattr(st, f.name) for f in fields(st)}
+            getattr(st, f.name) for f in fields(st) if getattr(st, f.name) is not None}
 
 
 def _imu_rows(t, block) -> dict[str, np.ndarray]:

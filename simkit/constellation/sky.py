@@ -48,6 +48,14 @@ class Sky:
                 return tuple(k.alpha), tuple(k.beta)
         return None
 
+    def time_offsets(self) -> dict:
+        """Broadcast system-time offsets by kind (``Constellation.time_offsets``), the first source's per kind."""
+        out: dict = {}
+        for c in self.constellations:
+            for kind, off in c.time_offsets.items():
+                out.setdefault(kind, off)
+        return out
+
     def group_delays(self, gps_week, gps_sow) -> dict[str, np.ndarray]:
         """Broadcast group delays name -> (S,) s (NaN where a source has none), records nearest the epoch."""
         out: dict[str, np.ndarray] = {}

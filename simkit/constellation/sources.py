@@ -1,5 +1,5 @@
 """``load(source)``: a file path, a bundled file name (simkit/data/) or ``nominal:<name>``, format detected
-from the file's content (RINEX navigation, YUMA, SEM, TLE)."""
+from the file's content (RINEX navigation, YUMA, SEM, GSC Galileo XML almanac, TLE)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -36,8 +36,8 @@ def load(source, *, validity_days: float | None = None, systems: str | None = No
     ``nominal:gps+bds``, ``nominal:gal``, ``nominal:glo``, ``nominal:gps+bds+gal+glo``; a file path; a bundled
     file name; or ``almanac:<RINEX nav source>`` (an almanac derived
     from the broadcast records nearest the middle of the file, see :func:`almanac.from_ephemeris`). Files: RINEX 3.0x/4.00 navigation (plain or .gz),
-    YUMA or SEM GPS almanacs, TLE sets (2- or 3-line). ``validity_days`` (almanac and TLE sources only) is the
-    span either side of the almanac/TLE epoch in which states are returned (default 7 days); broadcast
+    YUMA or SEM GPS almanacs, GSC Galileo almanacs (XML), TLE sets (2- or 3-line). ``validity_days`` (almanac and
+    TLE sources only) is the span either side of the almanac/TLE epoch in which states are returned (default 7 days); broadcast
     ephemerides always use their fit interval (GPS, QZSS +-2 h, BDS +-1 h, GLONASS +-30 min; Galileo the latest
     record before t, for 4 h).
     ``systems`` (RINEX navigation files only): the system letters to keep, e.g. ``"GC"`` (default: all of
@@ -58,18 +58,21 @@ def load(source, *, validity_days: float | None = None, systems: str | None = No
 
         return nominal(text.split(":", 1)[1])
     path = resolve(source)
-    from . import almanac, rinex_nav, tle
+    from . import almanac, galileo_almanac, rinex_nav, tle
     from .textfile import lines_of, read_bytes
 
     raw = read_bytes(path)
     if rinex_nav.is_rinex_nav(lines_of(raw[:200])):
         return rinex_nav.read(path, raw, systems)
-    lines = lines_of(raw)
     kw = {} if validity_days is None else {"validity_days": validity_days}
+    if galileo_almanac.is_gsc_xml(raw[:500]):
+        return galileo_almanac.read(path, raw, **kw)
+    lines = lines_of(raw)
     if almanac.is_yuma(lines):
         return almanac.read_yuma(path, lines, **kw)
     if almanac.is_sem(lines):
         return almanac.read_sem(path, lines, **kw)
     if tle.is_tle(lines):
         return tle.read(path, lines, **kw)
-    raise DataFileError(path, "unknown format: expected RINEX 3/4 navigation, YUMA or SEM almanac, or TLEs", 1)
+    raise DataFileError(path, "unknown format: expected RINEX 3/4 navigation, YUMA or SEM almanac, "
+                        "GSC Galileo XML almanac, or TLEs", 1)

@@ -1,7 +1,8 @@
 """Two-line element sets propagated with skyfield's EarthSatellite (SGP4), converted TEME -> ITRS by skyfield.
 
-Satellites are identified from the name line: '(PRN 13)' -> G13 (GPS sets), '(C19)' -> C19 (BeiDou sets);
-objects without a PRN in their name are skipped. TLEs carry no clock: the clock and drift are zero.
+Satellites are identified from the name line: '(PRN 13)' -> G13 (GPS sets), '(C19)' -> C19 (BeiDou sets),
+'GSAT0101 (GALILEO-PFM)' or '(PRN E11)' -> E11 (Galileo sets, see :mod:`.galileo_satellites`); objects
+without such an id in their name are skipped. TLEs carry no clock: the clock and drift are zero.
 States are returned within ``validity_days`` (default 7) of each TLE's epoch, NaN outside.
 """
 from __future__ import annotations
@@ -12,6 +13,7 @@ import numpy as np
 
 from .. import gpstime
 from ..errors import DataFileError
+from . import galileo_satellites
 from .model import Constellation, orbit_types
 
 DEFAULT_VALIDITY_DAYS = 7.0
@@ -41,7 +43,7 @@ def _sat_id(name: str):
     m = _BDS.search(name)
     if m and "BEIDOU" in name.upper():
         return f"C{int(m.group(1)):02d}"
-    return None
+    return galileo_satellites.sat_id(name)
 
 
 class TleConstellation(Constellation):
@@ -89,7 +91,8 @@ class TleConstellation(Constellation):
 
 
 def read(path, lines, validity_days: float = DEFAULT_VALIDITY_DAYS) -> TleConstellation:
-    """Parse a 3-line (name + 2 lines) TLE set; only satellites with a GPS or BDS PRN in their name are kept."""
+    """Parse a 3-line (name + 2 lines) TLE set; only satellites with a GPS, BDS or Galileo id in their name are
+    kept."""
     body = [(i, ln.rstrip()) for i, ln in enumerate(lines, 1) if ln.strip()]
     sats, k = [], 0
     while k < len(body):
@@ -114,7 +117,8 @@ def read(path, lines, validity_days: float = DEFAULT_VALIDITY_DAYS) -> TleConste
             sats.append((sid, name, l1, l2, float(l1[18:32])))
         k += 2
     if not sats:
-        raise DataFileError(path, "no GPS or BDS satellite with a PRN in its name ('(PRN nn)' or '(Cnn)')")
+        raise DataFileError(path, "no GPS, BDS or Galileo satellite with an id in its name "
+                            "('(PRN nn)', '(Cnn)', 'GSATnnnn' or '(PRN Enn)')")
     best = {}
     for sat in sats:  # the newest TLE per PRN
         if sat[0] not in best or _epoch_key(sat[4]) > _epoch_key(best[sat[0]][4]):

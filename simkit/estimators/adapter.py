@@ -13,7 +13,8 @@ from .. import attitude as gnss_attitude
 from ..gnss.differencing import systems_of
 from ..gnss.spp import SppFixes, spp
 from ..io import broadcast_ionosphere as file_ionosphere
-from ..io import has, n_antennas, read_gnss, read_imu
+from ..constellation import time_offsets
+from ..io import broadcast_time_offsets, has, n_antennas, read_gnss, read_imu
 from .errors import EstimatorInputError
 from .filters import FilterConfig
 from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData
@@ -61,9 +62,14 @@ def spp_fixes(ds, p):
         iono, why = broadcast_ionosphere(ds, p)
     if p["systems"]:
         code = np.where(np.isin(systems_of(g.sat_id), list(p["systems"]))[None, :], code, np.nan)
+    sow = float(ds.attrs["start_gps_sow"]) + g.t
+    offset = None
+    if p["clock"] == "single":  # one receiver clock: the satellites' clocks are moved to GPS time first
+        offset = time_offsets.evaluate(broadcast_time_offsets(ds), systems_of(g.sat_id),
+                                       int(ds.attrs["start_gps_week"]), sow)[0]
     fx = spp(g.t, code, doppler, wl, g.sat_pos_ecef, g.sat_clock, systems_of(g.sat_id), gd,
              p["elevation_mask_deg"], p["sigma_code_m"], p["sigma_doppler_m_per_s"], iono_coefficients=iono,
-             gps_sow=float(ds.attrs["start_gps_sow"]) + g.t)
+             gps_sow=sow, time_offset_s=offset, single_clock=p["clock"] == "single")
     return SppFixes(**{**fx.__dict__, "ionosphere": why})
 
 

@@ -18,7 +18,7 @@ from .filters import HInfinityFilter, KalmanFilter15, KalmanFilter15DD, KalmanFi
 from .truth_inputs import TRUTH_KEYS, truth_inputs
 
 COMMON = {"gnss": "spp", "antenna": 0, "elevation_mask_deg": 10.0, "sigma_code_m": 1.0,
-          "sigma_doppler_m_per_s": 0.04, "ionosphere": "broadcast", "systems": "",
+          "sigma_doppler_m_per_s": 0.04, "ionosphere": "broadcast", "systems": "", "clock": "per-system",
           "truth_pos_sigma_m": [1.0, 1.0, 5.0], "truth_vel_sigma_m_per_s": 0.05,
           "seed": 0}
 FILTER = {"align": "auto", "align_static_s": 10.0, "init_heading_error_deg": 0.0, "p0_att_deg": [1.0, 1.0, 10.0],

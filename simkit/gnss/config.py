@@ -15,7 +15,7 @@ from . import clock, signals
 from .truth_config import TruthErrorsConfig, parse_truth_errors
 
 ERROR_TERMS = ("receiver_clock", "satellite_clock", "group_delay", "ionosphere", "troposphere", "multipath",
-               "noise", "cycle_slips")
+               "noise", "cycle_slips", "system_time_offset")
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,8 @@ class GnssStatic:
     iono_systems: np.ndarray
     iono_alpha: np.ndarray
     iono_beta: np.ndarray
+    time_offset_systems: np.ndarray | None = None  # (Z,) systems whose broadcast time offset to GPS is applied
+    time_offset: np.ndarray | None = None          # (Z, 4): a0 s, a1 s/s, t_ref GPS week, t_ref s of week
 
 
 @dataclass(frozen=True)
@@ -86,6 +88,7 @@ class GnssTruth:
     satellite_clock_error: np.ndarray
     los_state: np.ndarray | None = None        # with an [environment]: (M, A, S) uint8, see simkit.environment
     nlos_delay: np.ndarray | None = None       # with an [environment]: (M, A, S) m, extra path of the reflection
+    system_time_offset: np.ndarray | None = None  # (M, S) m: -c (system time - GPS time), when one is applied
 
 
 @dataclass(frozen=True)

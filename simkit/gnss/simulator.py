@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import frames, gpstime, rng
-from ..constellation import Sky, antenna_view
+from ..constellation import Sky, antenna_view, time_offsets
 from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
 from ..errors import DataFileError, ScenarioError
@@ -80,6 +80,11 @@ class GnssSimulator:
         self.freq = np.array([[g.frequency_for(channels[s]) if g.is_fdma else g.freq_hz for g in self.signals]
                               for s in range(len(self.sat_ids))], dtype=float).reshape(len(self.sat_ids), -1)
         self.group_delay_s = self._group_delays()
+        # broadcast system time minus GPS time per simulated system (Galileo GGTO, QZSS, BDS fraction): a receiver
+        # counting GPS time sees it in every range of that system's satellites (docs/systems.md)
+        simulated = sorted(set(self.system[self.carries.any(axis=1)]))
+        self.time_poly = time_offsets.polynomials(sky.time_offsets(), simulated) \
+            if cfg.errors["system_time_offset"] else {}
         n_clk = self.n_ant if cfg.clock_mode == "per_antenna" else 1
         self.clocks = [ClockProcess(cfg.oscillator, self.dt, rng.generator(seed, "gnss", "clock",
                                                                             f"ant{a}" if n_clk > 1 else "common"))
@@ -153,7 +158,16 @@ class GnssSimulator:
                           wavelength_m=np.array([g.wavelength_m for g in self.signals]),
                           sat_frequency_hz=self.freq,
                           group_delay=self.group_delay_s * C_LIGHT * self.cfg.errors["group_delay"],
-                          lever_arm_b=self.lever, boresight_b=self.boresight, **self._klobuchar_rows())
+                          lever_arm_b=self.lever, boresight_b=self.boresight, **self._klobuchar_rows(),
+                          **self._time_offset_rows())
+
+    def _time_offset_rows(self) -> dict[str, np.ndarray]:
+        """The broadcast system-time offsets applied (none: no datasets, files stay as before)."""
+        if not self.time_poly:
+            return {}
+        systems = sorted(self.time_poly)
+        return {"time_offset_systems": np.array(systems, dtype="U1"),
+                "time_offset": np.array([self.time_poly[k] for k in systems], dtype=float).reshape(-1, 4)}
 
     def _klobuchar_rows(self) -> dict[str, np.ndarray]:
         """The broadcast Klobuchar coefficients used, one row per simulated system with a model (G, C)."""
@@ -279,6 +293,13 @@ class _Parts:
         self.sat_clk = -C_LIGHT * np.nan_to_num(view.sat_clock) * err["satellite_clock"]
         self.sat_clk_rate = (-C_LIGHT * np.nan_to_num(view.sat_drift) * (1.0 - view.range_rate / C_LIGHT)
                              * err["satellite_clock"])
+        self.sys_offset = None
+        if sim.time_poly:  # the satellite clock against GPS time: its broadcast clock plus its system's offset
+            off, off_rate = time_offsets.evaluate(sim.time_poly, sim.system, self.week, self.sow)   # (M, S)
+            self.sys_offset = -C_LIGHT * off                                                        # (M, S) m
+            self.sat_clk = self.sat_clk + self.sys_offset[:, None, self.cand]
+            self.sat_clk_rate = self.sat_clk_rate - (C_LIGHT * off_rate[:, None, self.cand]
+                                                     * (1.0 - view.range_rate / C_LIGHT))
         self.clk = self.rx_clk[..., None] + self.sat_clk
         self.clk_rate = self.rx_clk_rate[..., None] + self.sat_clk_rate
 
@@ -450,5 +471,6 @@ class _Parts:
                          troposphere_model_error=self.full(self.trop_error),
                          orbit_range_error=self.full(self.orb), orbit_error_rac=self.orbit_rac,
                          satellite_clock_error=self.sat_clk_error,
+                         system_time_offset=self.sys_offset,
                          los_state=None if self.los is None else self.full(self.los.state, 255),
                          nlos_delay=None if self.los is None else self.full(self.los.extra))

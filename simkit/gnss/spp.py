@@ -182,21 +182,32 @@ def _delays(systems, wavelength_m, iono_coefficients, gps_sow, m) -> _Delays:
 
 def spp(t, code, doppler, wavelength_m, sat_pos_ecef, sat_clock_s, systems, group_delay_m=None,
         elevation_mask_deg=10.0, sigma_code_m=3.0, sigma_doppler_m_per_s=0.1, iterations=10,
-        iono_coefficients=None, gps_sow=None) -> SppFixes:
+        iono_coefficients=None, gps_sow=None, time_offset_s=None, single_clock=False) -> SppFixes:
     """Single-point position and velocity. ``code`` (M, S) m and ``doppler`` (M, S) Hz of one antenna (NaN
     where not tracked; ``doppler`` None: position only, NaN velocity); ``wavelength_m`` (S,) per satellite's signal; ``sat_pos_ecef`` (M, S, 3) m;
     ``sat_clock_s`` (M, S) s; ``systems`` (S,) system letters; ``group_delay_m`` (S,) m;
     ``iono_coefficients`` {'G' or 'C': (alpha (4,), beta (4,))} broadcast Klobuchar coefficients (s, s/semicircle,
-    ...; None: no ionospheric correction) with ``gps_sow`` (M,) the epochs' GPS seconds of week."""
+    ...; None: no ionospheric correction) with ``gps_sow`` (M,) the epochs' GPS seconds of week.
+    ``time_offset_s`` (M, S) s: broadcast system time minus GPS time of each satellite's system (Galileo GGTO, ...),
+    added to the satellite clocks so they count GPS time; ``single_clock``: one receiver clock for every system
+    (``clock`` (M, 1), ``systems`` one string of the letters) instead of one per system (per-system clocks absorb
+    the offsets; one clock needs them removed)."""
     t, code = np.asarray(t, float), np.asarray(code, float)
     m, s = code.shape
     doppler = np.full((m, s), np.nan) if doppler is None else np.asarray(doppler, float)
     if sat_pos_ecef.shape != (m, s, 3) or doppler.shape != (m, s) or sat_clock_s.shape != (m, s):
         raise SppInputError(f"spp: expected code/doppler (M, S), sat_pos_ecef (M, S, 3), sat_clock (M, S) "
                             f"with M={m}, S={s}; got {doppler.shape}, {sat_pos_ecef.shape}, {sat_clock_s.shape}")
+    if time_offset_s is not None:
+        time_offset_s = np.asarray(time_offset_s, float)
+        if time_offset_s.shape != (m, s):
+            raise SppInputError(f"spp: expected time_offset_s (M, S) with M={m}, S={s}; got {time_offset_s.shape}")
+        sat_clock_s = sat_clock_s + np.nan_to_num(time_offset_s)
     systems = np.asarray(systems)
     names = tuple(sorted(set(systems)))
     onehot = (systems[:, None] == np.array(names)[None, :]).astype(float)
+    if single_clock:
+        names, onehot = ("".join(names),), np.ones((s, 1))
     gd = np.zeros(s) if group_delay_m is None else np.nan_to_num(np.asarray(group_delay_m, float))
     sat = np.nan_to_num(sat_pos_ecef)
     corrected = code + C_LIGHT * sat_clock_s - gd

@@ -223,6 +223,16 @@ def broadcast_ionosphere(ds):
     return {k: (alpha[i], beta[i]) for i, k in enumerate(systems)}
 
 
+def broadcast_time_offsets(ds):
+    """{system: (a0 s, a1 s/s, t_ref GPS week, t_ref s of week)} the broadcast system-time-minus-GPS-time
+    polynomials of /gnss/time_offset applied to the simulated ranges; {} when the file has none."""
+    if "gnss/time_offset" not in ds:
+        return {}
+    rows = ds["gnss/time_offset"][:]
+    return {str(k): (float(r[0]), float(r[1]), int(r[2]), float(r[3]))
+            for k, r in zip(ds["gnss/time_offset_systems"][:], rows)}
+
+
 def reference_truth(ds) -> Truth | None:
     """The static /reference of a real file as a :class:`Truth` over its GNSS epochs (None without one): the
     position twice (first and last epoch), zero velocity, an identity attitude and zero body rate that only carry

@@ -5,7 +5,8 @@ a path, dtype or shape that is not declared here and takes the units from here; 
 the RINEX exporter, the ``/solutions`` writer and the README table (``python -m simkit.io.schema``) follow it.
 
 Shape symbols: N truth/IMU samples, M GNSS epochs, A antennas, S satellites, G signals, K solution epochs,
-X solution states, Y satellite systems with a broadcast ionosphere model, R campaign runs. Placeholders in paths: ``<signal>`` a signal name (``L1C``, ``B1I``, ...),
+X solution states, Y satellite systems with a broadcast ionosphere model, Z systems with a broadcast time offset
+to GPS time applied, R campaign runs. Placeholders in paths: ``<signal>`` a signal name (``L1C``, ``B1I``, ...),
 ``<term>`` an IMU error term (``gyro_bias``, ``accel_white``, ...), ``<name>`` a solution name, ``<extra>`` a
 filter's extra output.
 """
@@ -94,6 +95,12 @@ _GNSS = [
        "the simulated ionosphere is this model when gnss.errors.ionosphere is on"),
     _f("gnss/iono_beta", "f8", ("Y", 4), "s, s/sc, s/sc^2, s/sc^3", "", "gnss",
        "broadcast Klobuchar period coefficients (RINEX GPSB/BDSB)"),
+    _f("gnss/time_offset_systems", "str", ("Z",), "", "", "gnss",
+       "systems whose broadcast time offset to GPS time is applied (E Galileo GGTO, J QZSS, C BDS beyond 14 s); "
+       "only when one is (gnss.errors.system_time_offset and a source that broadcasts it)"),
+    _f("gnss/time_offset", "f8", ("Z", 4), "s, s/s, week, s", "", "gnss",
+       "system time minus GPS time = a0 + a1 (t - t_ref) per row of time_offset_systems: a0, a1, t_ref GPS week, "
+       "t_ref s of week (RINEX GAGP/QZGP/BDGP)"),
     _f("gnss/sat_pos_ecef", "f8", ("M", "S", 3), "m", "ECEF at emission", "gnss",
        "satellite at emission time for the IMU centre, in the ECEF frame of the emission epoch (RTKLIB satposs)"),
     _f("gnss/sat_clock", "f8", ("M", "S"), "s", "", "gnss",
@@ -137,6 +144,9 @@ _GNSS = [
        "true minus broadcast satellite position"),
     _f("gnss/truth/satellite_clock_error", "f8", ("M", "S"), "m", "", "gnss",
        "true minus broadcast satellite clock term -c dT^s (as it enters the code)"),
+    _f("gnss/truth/system_time_offset", "f8", ("M", "S"), "m", "", "gnss",
+       "-c (system time - GPS time) of each satellite's system, part of truth/satellite_clock and of every range "
+       "(only when /gnss/time_offset is written)"),
     _f("gnss/truth/<signal>/ionosphere", "f8", ("M", "A", "S"), "m", "", "gnss",
        "code delay (the carrier gets minus this)"),
     _f("gnss/truth/<signal>/ionosphere_rate", "f8", ("M", "A", "S"), "m/s", "", "gnss", "its rate"),
