@@ -25,14 +25,22 @@ def _column(values) -> np.ndarray:
 
 
 def _common_shapes(run_files, paths) -> dict:
-    """path -> (shape, dtype str) for the paths that have one shape and dtype in every file."""
-    common = None
+    """path -> (shape, dtype str) for the paths that have one shape and dtype in every file (each file walked
+    once: opening every path by name cost the campaign's client 0.06 s per run file)."""
+    wanted, common = set(paths), None
     for fn in run_files:
+        here = {}
+
+        def visit(name, obj, here=here):
+            if name in wanted and isinstance(obj, h5py.Dataset):
+                dtype = obj.dtype
+                if h5py.check_string_dtype(dtype) is None:
+                    here[name] = (obj.shape, dtype.str)
+
         with h5py.File(fn, "r") as f:
-            here = {p: (f[p].shape, f[p].dtype.str) for p in paths
-                    if isinstance(f.get(p), h5py.Dataset) and h5py.check_string_dtype(f[p].dtype) is None}
+            f.visititems(visit)
         common = here if common is None else {p: v for p, v in common.items() if here.get(p) == v}
-    return common or {}
+    return {p: common[p] for p in paths if p in common} if common else {}
 
 
 def write_campaign_index(path, columns: dict[str, list], run_files: list, stack=()) -> list[str]:
