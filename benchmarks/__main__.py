@@ -1,0 +1,5 @@
+"""``python -m benchmarks``: the same as ``python benchmarks/run_all.py`` (see there)."""
+import runpy
+from pathlib import Path
+
+runpy.run_path(str(Path(__file__).resolve().parent / "run_all.py"), run_name="__main__")
