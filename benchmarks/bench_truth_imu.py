@@ -12,6 +12,7 @@ rate, with the STIM300's bias, ARW/VRW and bias instability (first-order Gauss-M
 + ``gyro_gen`` + ``acc_gen``, no start-up, no file), the strictest comparison.
 
     python benchmarks/bench_truth_imu.py [--seconds 600] [--rate 1000] [--peer DIR] [--json OUT]
+    python benchmarks/bench_truth_imu.py --ab OLD_TREE NEW_TREE [--rounds 3]     (before / after, no peer)
 """
 from __future__ import annotations
 
@@ -123,6 +124,24 @@ def theirs_in_memory(pathgen, seconds: float, rate: float) -> float:
     return res["nav"].shape[0] / (time.process_time() - c0)
 
 
+AB_PROBE = r"""
+import resource, subprocess, sys, time
+tree, scenario = sys.argv[1], sys.argv[2]
+t0 = time.perf_counter()
+subprocess.run([sys.executable, "-m", "simkit", "run", scenario, "-o", scenario + ".h5", "-q"], cwd=tree, check=True)
+r = resource.getrusage(resource.RUSAGE_CHILDREN)
+print(f"{time.perf_counter() - t0:.2f} {r.ru_utime + r.ru_stime:.2f}")
+"""
+
+
+def ab(trees, seconds: float, rate: float, rounds: int) -> None:
+    """``python -m simkit run`` of the same scenario in each tree, alternating (timing.ab): wall and CPU s."""
+    with tempfile.TemporaryDirectory(prefix="bench_truth_imu_ab_") as tmp:
+        path = Path(tmp) / "truth_imu.toml"
+        path.write_text(scenario(seconds, rate))
+        timing.ab(trees, AB_PROBE, ["wall s", "CPU s"], rounds, path, own_cache=True)
+
+
 def measure(seconds: float = 600.0, rate: float = 1000.0, peer: str | None = None) -> dict:
     """Every figure of this benchmark, measured in this run (the peer's are None without a checkout)."""
     n = int(round(seconds * rate)) + 1
@@ -173,7 +192,12 @@ def main(argv=None) -> int:
     ap.add_argument("--rate", type=float, default=1000.0)
     ap.add_argument("--peer", help="gnss-ins-sim checkout (default: $GNSS_INS_SIM)")
     ap.add_argument("--json", help="also write the figures as JSON to this file")
+    ap.add_argument("--ab", nargs=2, metavar=("A", "B"), help="time two checkouts against each other instead")
+    ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args(argv)
+    if args.ab:
+        ab(args.ab, args.seconds, args.rate, args.rounds)
+        return 0
     r = measure(args.seconds, args.rate, args.peer)
     print(f"{r['samples']:,} samples ({args.seconds:g} s at {args.rate:g} Hz), load average "
           f"{r['load_before']:.2f} before, {r['load_after']:.2f} after; simkit file {r['ours']['bytes'] / 1e6:.0f} MB"
