@@ -57,10 +57,11 @@ def write_campaign_index(path, columns: dict[str, list], run_files: list, stack=
                 spec = schema.check(f"campaign/runs/{name}", data.dtype if data.dtype.kind != "O" else "U1",
                                     data.shape)
                 f.create_dataset(f"campaign/runs/{name}", data=data).attrs["units"] = spec.units
+            sources = [os.path.relpath(fn, path.parent) for fn in run_files]
             for p, (shape, dtype) in _common_shapes(run_files, stack).items():
                 layout = h5py.VirtualLayout(shape=(len(run_files),) + shape, dtype=np.dtype(dtype))
-                for i, fn in enumerate(run_files):
-                    layout[i] = h5py.VirtualSource(os.path.relpath(fn, path.parent), p, shape=shape)
+                for i, source in enumerate(sources):
+                    layout[i] = h5py.VirtualSource(source, p, shape=shape)
                 name = f"campaign/virtual/{p.replace('/', '.')}"
                 schema.check(name, np.dtype(dtype), (len(run_files),) + shape)
                 f.create_virtual_dataset(name, layout, fillvalue=None)
