@@ -7,7 +7,7 @@ Each run is a CPU-bound simulation of the xian_static_bds geometry (three antenn
 10 Hz) for --duration seconds plus its metrics (imu_errors, gnss_errors, single-epoch ILS ambiguity). The machine
 load (1-minute load average) is printed before and after: on a shared 2-core machine the speed-up is bounded by
 what the other users leave. Both pools are warmed first (one run per process: imports, numba caches), so the
-figures compare steady-state throughput; the peer forks from this process, Dask spawns fresh interpreters.
+figures compare steady-state throughput; both spawn fresh interpreters.
 """
 from __future__ import annotations
 
@@ -20,6 +20,7 @@ for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import logging  # noqa: E402
+import multiprocessing  # noqa: E402
 import shutil  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -55,7 +56,8 @@ def _pool(tmp: Path, runs: int, over: list[str], processes: int) -> float:
     run_dir.mkdir(parents=True)
     warm = plan("xian_static_bds", processes, first_seed=10**6, overrides=over)
     specs = plan("xian_static_bds", runs, overrides=over)
-    with ProcessPoolExecutor(processes) as pool:
+    # spawned like Dask's workers: forking a process that already ran OpenMP threads (numba) is unsafe
+    with ProcessPoolExecutor(processes, mp_context=multiprocessing.get_context("spawn")) as pool:
         list(pool.map(execute, warm, [str(run_dir)] * processes, [DEFAULT_METRICS] * processes))
         t0 = time.perf_counter()
         recs = list(pool.map(execute, specs, [str(run_dir)] * runs, [DEFAULT_METRICS] * runs))
