@@ -2,4 +2,5 @@
 import runpy
 from pathlib import Path
 
-runpy.run_path(str(Path(__file__).resolve().parent / "run_all.py"), run_name="__main__")
+if __name__ == "__main__":  # not in the interpreters that multiprocessing spawns from this one
+    runpy.run_path(str(Path(__file__).resolve().parent / "run_all.py"), run_name="__main__")

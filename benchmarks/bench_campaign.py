@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 
 # one BLAS / OpenMP thread per process, set before numpy loads: Dask's nanny does the same for its workers
-# (distributed.nanny.pre-spawn-environ), so the process-pool peer forked from here runs under the same rule
+# (distributed.nanny.pre-spawn-environ), so the process-pool peer started from here runs under the same rule
 for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
