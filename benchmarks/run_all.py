@@ -129,15 +129,21 @@ def kf(quick: bool):
 
 
 def lambda_(quick: bool):
+    import math
+
     import bench_lambda
 
     try:
         rows = bench_lambda.measure((10, 20, 40), 8 if quick else 30)
     except ImportError as exc:
         return [("ILS, n = 10, 20, 40 (us per solve)", "-", _peer_missing(exc), "-")]
-    return [(f"ILS n = {n}, 2 candidates (us per solve); peer: RTKLIB lambda (C), cssrlib mlambda",
-             f"{ms:.1f}", f"C {mr:.1f}, cssrlib {mc:.0f}", f"C/simkit {mr / ms:.2f}, cssrlib/simkit {mc / ms:.0f}")
-            for n, ms, mr, mc in rows]
+    out = []
+    for n, ms, mr, mc in rows:
+        cssr = f"cssrlib {mc:.0f}" if not math.isnan(mc) else f"cssrlib: {ABSENT}"
+        ratio = f"C/simkit {mr / ms:.2f}" + (f", cssrlib/simkit {mc / ms:.0f}" if not math.isnan(mc) else "")
+        out.append((f"ILS n = {n}, 2 candidates (us per solve); peers: RTKLIB lambda (C), cssrlib mlambda",
+                    f"{ms:.1f}", f"C {mr:.1f}, {cssr}", ratio))
+    return out
 
 
 def campaign(quick: bool):
@@ -207,6 +213,16 @@ def markdown(rows, quick: bool) -> str:
     return head + body + END
 
 
+def previous_rows(doc: Path = DOC) -> list[tuple]:
+    """The rows of the table now between the markers of ``doc`` (none when absent)."""
+    text = doc.read_text()
+    if BEGIN not in text or END not in text:
+        return []
+    lines = text[text.index(BEGIN):text.index(END)].splitlines()
+    cells = [tuple(c.strip() for c in line.strip().strip("|").split("|")) for line in lines if line.startswith("| ")]
+    return [c for c in cells[1:] if len(c) == 7]                     # past the header row
+
+
 def write(text: str, doc: Path = DOC) -> None:
     """Replace the text between the markers in ``doc`` (appended with a heading when the markers are absent)."""
     old = doc.read_text()
@@ -222,10 +238,15 @@ def write(text: str, doc: Path = DOC) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="shorter records: minutes instead of tens of minutes")
-    ap.add_argument("--only", nargs="+", choices=sorted(BENCHMARKS), help="run these benchmarks only")
+    ap.add_argument("--only", nargs="+", choices=sorted(BENCHMARKS),
+                    help="run these benchmarks only; the table keeps the other benchmarks' rows from the last run")
     ap.add_argument("--no-write", action="store_true", help="print the table, leave docs/benchmarks.md alone")
     args = ap.parse_args(argv)
     rows = run(args.only or list(BENCHMARKS), args.quick)
+    if args.only:  # the other benchmarks keep their rows (and dates) from the last run
+        kept = [r for r in previous_rows() if r[0] not in args.only]
+        order = list(BENCHMARKS)
+        rows = sorted(kept + rows, key=lambda r: order.index(r[0]) if r[0] in order else len(order))
     timing.print_table(["benchmark", "figure", "simkit", "peer (same run)", "ratio", "date (UTC)", "load"], rows)
     if not args.no_write:
         write(markdown(rows, args.quick))

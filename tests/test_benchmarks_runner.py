@@ -21,6 +21,8 @@ def test_table_replaces_only_the_text_between_the_markers(tmp_path):
     assert "--quick" in text and "cores" in text
     run_all.write(run_all.markdown(rows, quick=False), doc)           # idempotent: one table, replaced
     assert doc.read_text().count(run_all.BEGIN) == 1
+    assert run_all.previous_rows(doc) == [("truth", "fig / with bar", "1.0", "peer absent (x)", "-",
+                                           "2026-01-01 00:00", "0.5 / 0.6")]
 
 
 def test_a_failing_benchmark_is_a_row_and_the_others_still_run(monkeypatch):
