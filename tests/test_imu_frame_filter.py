@@ -50,7 +50,7 @@ def test_gauss_markov_equals_lfilter_and_any_cut():
 def test_flicker_equals_its_branches_through_lfilter():
     b, tau_min, tau_max, dt = 1e-5, 0.1, 1e3, 1e-3
     fl = Flicker(b, tau_min, tau_max, dt, np.random.default_rng(8))
-    start = fl.filter.state.copy()                   # the branches' stationary draw (n, 3)
+    start = fl.state.copy()                          # the branches' stationary draw (n, 3)
     p, c = flicker_design(b, tau_min, tau_max, dt)
     rng = np.random.default_rng(8)
     rng.standard_normal((p.size, 3))                 # the stationary draw comes first from the stream

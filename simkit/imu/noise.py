@@ -102,8 +102,6 @@ class FrameFilter:
         self.carry = c @ powers[:frame]                                         # (L, n): C A^j
         self.drive = (powers[frame - 1::-1] @ b).T.copy()                       # (n, L): A^(L-1-l) B
         self.a_frame = powers[frame]
-        if not np.any(self.a_frame - np.diag(np.diag(self.a_frame))):         # diagonal (flicker, Gauss-Markov)
-            self.a_frame = np.diag(self.a_frame)[:, None].copy()                # then a product by elements
         self.state = np.array(state, dtype=float).reshape(b.size, -1)          # at the start of the open frame
         self.pending = np.empty((0, self.state.shape[1]))                       # inputs of the open frame
 
@@ -117,10 +115,10 @@ class FrameFilter:
         flat[:done], flat[done:total] = self.pending, x
         drive = np.matmul(self.drive, frames[:full])                            # (full, n, axes)
         starts = np.empty((frames.shape[0],) + self.state.shape)
-        s, step = self.state, (np.multiply if self.a_frame.shape[1] == 1 else np.matmul)
+        s = self.state
         for f in range(full):
             starts[f] = s
-            s = step(self.a_frame, s) + drive[f]
+            s = self.a_frame @ s + drive[f]
         if full < frames.shape[0]:
             starts[full] = s
         self.state = s
@@ -129,14 +127,58 @@ class FrameFilter:
         return y.reshape(-1, axes)[done:total]
 
 
-class ShapedNoise:
-    """Unit white noise, drawn sample-major from ``rng``, through a :class:`FrameFilter`."""
+# Frames per batch of :class:`ShapedNoise`: noise is drawn and filtered in batches aligned to the record start.
+BATCH_FRAMES = 64
 
-    def __init__(self, filt: FrameFilter, rng: np.random.Generator):
-        self.filter, self.rng = filt, rng
+
+class ShapedNoise:
+    """Unit white noise w through n first-order filters sharing it, s_i[k] = a_i s_i[k-1] + b_i w[k], summed as
+    y[k] = sum_i c_i s_i[k-1] + d w[k], on ``axes`` independent axes (state (n, axes)).
+
+    The :class:`FrameFilter` products without its frame-to-frame loop: the noise is drawn and filtered in whole
+    batches of :data:`BATCH_FRAMES` frames aligned to the record start and handed out from a buffer, so the
+    frame-start states of a batch follow in closed form (s0 of frame f = sum_{g<f} a^(L (f-1-g)) G w_g
+    + a^(L f) s0 of the batch, one (C x C) product per state) and every product has one shape whatever the
+    caller's blocks: a record cut into any blocks is bit-identical to the record in one call.
+    """
+
+    def __init__(self, a, b, c, d: float, state: np.ndarray, rng: np.random.Generator):
+        a, b, c = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (a, b, c))
+        frame, count = FRAME, BATCH_FRAMES
+        pw = a[None, :] ** np.arange(frame + 1)[:, None]                   # (L + 1, n): a^j
+        h = np.concatenate([[d], pw[:frame - 1] @ (c * b)])
+        lag = np.arange(frame)[:, None] - np.arange(frame)[None, :]
+        self.toeplitz = np.where(lag >= 0, h[np.clip(lag, 0, None)], 0.0)  # (L, L)
+        self.carry = pw[:frame] * c                                          # (L, n): c a^j
+        self.drive = (pw[frame - 1::-1] * b).T.copy()                        # (n, L): a^(L-1-l) b
+        a_frame = pw[frame]
+        steps = np.arange(count)[:, None] - np.arange(count)[None, :] - 1   # f - 1 - g
+        self.scan = np.where(steps >= 0, a_frame[:, None, None] ** np.clip(steps, 0, None), 0.0)  # (n, C, C)
+        self.from_start = (a_frame[:, None] ** np.arange(count)[None, :])[:, :, None]           # (n, C, 1)
+        self.to_end = (a_frame[:, None] ** np.arange(count - 1, -1, -1)[None, :])[:, None, :]   # (n, 1, C)
+        self.a_batch = a_frame ** count
+        self.state = np.array(state, dtype=float).reshape(a.size, -1)
+        self.rng = rng
+        self.ready = np.empty((0, self.state.shape[1]))
+
+    def _batch(self) -> np.ndarray:
+        axes = self.state.shape[1]
+        frame, count = FRAME, BATCH_FRAMES
+        w = self.rng.standard_normal((count, frame, axes))               # sample-major: the stream's order
+        drive = np.matmul(self.drive, w).transpose(1, 0, 2)                 # (n, C, axes)
+        starts = np.matmul(self.scan, drive) + self.from_start * self.state[:, None, :]
+        self.state = self.a_batch[:, None] * self.state + np.matmul(self.to_end, drive)[:, 0]
+        y = np.matmul(self.toeplitz, w) + np.matmul(self.carry, starts.transpose(1, 0, 2))
+        return y.reshape(count * frame, axes)
 
     def block(self, count: int) -> np.ndarray:
-        return self.filter.apply(self.rng.standard_normal((count, self.filter.state.shape[1])))
+        parts, have = [self.ready], self.ready.shape[0]
+        while have < count:
+            parts.append(self._batch())
+            have += parts[-1].shape[0]
+        merged = np.concatenate(parts) if len(parts) > 1 else self.ready
+        self.ready = merged[count:].copy()
+        return merged[:count]
 
 
 def gauss_markov(sigma: float, tau_s: float, dt: float, rng: np.random.Generator, axes: int = 3) -> ShapedNoise:
@@ -145,7 +187,7 @@ def gauss_markov(sigma: float, tau_s: float, dt: float, rng: np.random.Generator
     from ..processes import ar1_coefficients
 
     phi, drive = ar1_coefficients(sigma, tau_s, dt)
-    return ShapedNoise(FrameFilter(phi, drive, phi, drive, sigma * rng.standard_normal(axes)), rng)
+    return ShapedNoise(phi, drive, phi, drive, sigma * rng.standard_normal(axes), rng)
 
 
 class Flicker(ShapedNoise):
@@ -165,7 +207,7 @@ class Flicker(ShapedNoise):
         vals, vecs = np.linalg.eigh(cov)
         root = vecs * np.sqrt(np.clip(vals, 0.0, None))
         state = root @ rng.standard_normal((p.size, axes))
-        super().__init__(FrameFilter(np.diag(phi), u, c * phi, float(np.dot(c, u)), state), rng)
+        super().__init__(phi, u, c * phi, float(np.dot(c, u)), state, rng)
 
 
 class Quantizer:
