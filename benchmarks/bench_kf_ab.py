@@ -7,13 +7,13 @@ fixes (``bench_kf.data``, of this checkout for both trees) and prints the best C
 """
 from __future__ import annotations
 
-import os
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import timing  # noqa: E402  (benchmarks/timing.py: the A/B runner)
 
 PROBE = r"""
 import sys, time
@@ -42,22 +42,7 @@ def main(argv=None) -> int:
     ap.add_argument("b")
     ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args(argv)
-    with tempfile.TemporaryDirectory() as tmp:
-        caches = {root: Path(tmp) / f"tree{i}" for i, root in enumerate((args.a, args.b))}
-
-        def probe(root):
-            env = dict(os.environ, NUMBA_CACHE_DIR=str(caches[root]))
-            out = subprocess.run([sys.executable, "-c", PROBE, str(Path(root).resolve()), str(ROOT / "benchmarks")],
-                                 env=env, capture_output=True, text=True, check=True)
-            return out.stdout.split()
-
-        for root in caches:
-            probe(root)  # compiles into the tree's cache
-        print(f"{'tree':<30} {'kf15 CPU s':>11} {'hinf CPU s':>11}")
-        for _ in range(args.rounds):
-            for root in caches:
-                print(f"{root:<30} " + " ".join(f"{v:>11}" for v in probe(root)))
-    print(f"load average (1 min): {os.getloadavg()[0]:.1f}")
+    timing.ab([args.a, args.b], PROBE, ["kf15 CPU s", "hinf CPU s"], args.rounds, ROOT / "benchmarks", own_cache=True)
     return 0
 
 

@@ -25,16 +25,22 @@ def _time(fn, reps):
     return (time.perf_counter() - t) / reps
 
 
-def main(sizes=(10, 20, 40), n_problems=30):
+def measure(sizes=(10, 20, 40), n_problems=30):
+    """[(n, simkit us, RTKLIB C us, cssrlib us)]: medians over ``n_problems`` problems of each size (cssrlib NaN
+    when it is not installed)."""
     import pyrtklib
-    from cssrlib.mlambda import mlambda
+
+    try:
+        from cssrlib.mlambda import mlambda
+    except ImportError:
+        mlambda = None
 
     rtk = getattr(pyrtklib, "lambda")
     ils(np.zeros(3), np.eye(3))
     wait_for_jit()  # time the compiled kernel, not the interpreted one that answers while numba compiles
     devnull = os.open(os.devnull, os.O_WRONLY)
     saved = os.dup(2)
-    print(f"{'n':>3} {'simkit us':>10} {'RTKLIB C us':>12} {'cssrlib us':>11} {'simkit/C':>9} {'cssrlib/simkit':>15}")
+    rows = []
     for n in sizes:
         rng = np.random.default_rng(n)
         ts, tr, tc = [], [], []
@@ -53,8 +59,15 @@ def main(sizes=(10, 20, 40), n_problems=30):
                 tr.append(_time(lambda: rtk(n, 2, ab, Qb, F, s), 200))
             finally:
                 os.dup2(saved, 2)
-            tc.append(_time(lambda: mlambda(a, Q, 2), 2 if n >= 20 else 5))
-        ms, mr, mc = (np.median(x) * 1e6 for x in (ts, tr, tc))
+            if mlambda is not None:
+                tc.append(_time(lambda: mlambda(a, Q, 2), 2 if n >= 20 else 5))
+        rows.append((n, *(float(np.median(x) * 1e6) if x else float("nan") for x in (ts, tr, tc))))
+    return rows
+
+
+def main(sizes=(10, 20, 40), n_problems=30):
+    print(f"{'n':>3} {'simkit us':>10} {'RTKLIB C us':>12} {'cssrlib us':>11} {'simkit/C':>9} {'cssrlib/simkit':>15}")
+    for n, ms, mr, mc in measure(sizes, n_problems):
         print(f"{n:>3} {ms:>10.1f} {mr:>12.1f} {mc:>11.0f} {ms / mr:>9.2f} {mc / ms:>15.0f}")
 
 

@@ -8,11 +8,13 @@ a few per cent: each tree runs in its own interpreter, alternating, ``--rounds``
 """
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import timing  # noqa: E402  (benchmarks/timing.py: the A/B runner)
 
 PROBE = r"""
 import sys, time, numpy as np
@@ -53,11 +55,7 @@ def main(argv=None) -> int:
     ap.add_argument("b")
     ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args(argv)
-    print(f"{'tree':<30} {'n=10 us':>8} {'n=20 us':>8} {'n=40 us':>8}")
-    for _ in range(args.rounds):
-        for root in (args.a, args.b):
-            out = subprocess.run([sys.executable, "-c", PROBE, root, str(ROOT)], capture_output=True, text=True, check=True)
-            print(f"{root:<30} " + " ".join(f"{v:>8}" for v in out.stdout.split()))
+    timing.ab([args.a, args.b], PROBE, ["n=10 us", "n=20 us", "n=40 us"], args.rounds, ROOT)
     return 0
 
 

@@ -9,18 +9,21 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, fields
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import gpstime
-from .constellation import NoStateError, Sky, load_sky
-from .environment import Environment
 from .errors import DataFileError, OutputError, ScenarioError
-from .gnss import GnssSimulator
 from .imu import ImuSimulator
-from .io import Writer, check_output
+from .io.output import check_output
+from .io.writer import Writer
 from .scenario import Scenario, load, resolve
 from .trajectory import Trajectory
+
+if TYPE_CHECKING:  # the GNSS stages are imported when a scenario has [gnss]: a truth + IMU run starts 0.5 s sooner
+    from .constellation import Sky
+    from .gnss import GnssSimulator
 
 BLOCK_SAMPLES = 1 << 16
 GNSS_CELLS = 1 << 20  # ~8 MB per (M, A, S) float array handed from the GNSS stage to the writer
@@ -107,6 +110,9 @@ def build(sc: Scenario, sky: Sky | None = None) -> Stages:
     imu = ImuSimulator(sc.imu, sc.trajectory.rate_hz, sc.seed) if sc.imu is not None else None
     gnss = None
     if sc.gnss is not None:
+        from .environment import Environment
+        from .gnss import GnssSimulator
+
         sky = sky if sky is not None else _sky(sc)
         _check_sky_covers_run(sc, sky, next(traj.blocks(block_samples=1)).pos_ecef[0])
         env = None
@@ -146,6 +152,8 @@ def _scenario_file(scenario) -> Path | None:
 
 def _sky(sc: Scenario) -> Sky:
     """The constellation stage: load the sources, refuse duplicates and a sky with nothing to see."""
+    from .constellation import load_sky
+
     try:
         sky = load_sky(sc.gnss.sources, sc.gnss.nav_systems)
     except DataFileError as exc:
@@ -159,6 +167,8 @@ def _sky(sc: Scenario) -> Sky:
 def _check_sky_covers_run(sc: Scenario, sky: Sky, origin: np.ndarray) -> None:
     """One clear error when no satellite has a state, or none rises above the mask, at the start position
     ``origin`` (3,) m ECEF during the run (sampled every minute)."""
+    from .constellation import NoStateError
+
     t = np.linspace(0.0, sc.duration_s, int(min(sc.duration_s // _SKY_CHECK_STEP_S, _SKY_CHECK_MAX)) + 2)
     week, sow = gpstime.add_seconds(sc.start_week, sc.start_sow, t)
     for i, const in enumerate(sky.constellations):

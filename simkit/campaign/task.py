@@ -93,7 +93,7 @@ def execute(spec: RunSpec, run_dir: str, metric_names: tuple[str, ...], previous
             metrics = {}
         else:
             metrics = dict(previous.get("metrics", {}))
-        with open_dataset(h5) as ds:
+        with one_thread(), open_dataset(h5) as ds:
             metrics.update(evaluate(ds, [m for m in metric_names if m not in metrics]))
         rec.update(status="ok", sha256=previous["sha256"] if previous else file_digest(h5), metrics=metrics,
                    elapsed_s=(previous or {}).get("elapsed_s", time.perf_counter() - t0))

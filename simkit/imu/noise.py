@@ -3,16 +3,18 @@
 Each generator draws from its own random stream in sample-major order and carries its state between blocks, so a
 record cut into any blocks is bit-identical to the record made in one call. A sample represents the interval
 (t[k-1], t[k]] of length ``dt``; every discretisation below is exact (or accurate to O(dt/tau)) for the continuous
-process, so the same physical spec gives the same Allan deviation at any sample rate. The first-order
-Gauss-Markov bias terms use the bank shared with the GNSS multipath, :class:`simkit.processes.GaussMarkov`.
+process, so the same physical spec gives the same Allan deviation at any sample rate.
+
+The coloured processes (flicker, first-order Gauss-Markov) are linear filters of white noise, run by
+:class:`ShapedNoise` as matrix products over frames of samples: numpy and BLAS only, so that a run without a
+quantizer or a bandwidth never starts numba (its first kernel costs a process about 0.5 s of CPU). The two filters
+of a deterministic input, the quantizer and the bandwidth low-pass, run compiled (:mod:`.kernels`).
 """
 from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
-from scipy import signal
 
 # Flicker band: correlation times log-spaced at this many per decade (ripple of the ADEV floor < 1 %).
 FLICKER_POLES_PER_DECADE = 2
@@ -70,21 +72,125 @@ def flicker_design(b: float, tau_min: float, tau_max: float, dt: float):
     return p, gain * c
 
 
-@numba.njit(cache=True)
-def _flicker_kernel(w, phi, u, c, state, out):  # pragma: no cover - compiled
-    n, axes = w.shape
-    m = phi.shape[0]
-    for k in range(n):
-        for a in range(axes):
-            acc = 0.0
-            for i in range(m):
-                s = phi[i] * state[i, a] + u[i] * w[k, a]
-                state[i, a] = s
-                acc += c[i] * s
-            out[k, a] = acc
+# Samples per frame of :class:`FrameFilter`: the outputs of a frame are one (FRAME x FRAME) matrix product.
+FRAME = 64
 
 
-class Flicker:
+class FrameFilter:
+    """The linear filter s[k] = A s[k-1] + B x[k], y[k] = C s[k-1] + D x[k] (n states, one input and one output per
+    axis) on ``axes`` independent axes, vectorised over time.
+
+    Frames of L = :data:`FRAME` samples, aligned to the record start: inside a frame y = T x + P s0, with the
+    lower-triangular Toeplitz matrix of the impulse response (T[j, j] = D, T[j, l] = C A^(j-l-1) B) and
+    P[j] = C A^j; the state steps from frame to frame as s0' = A^L s0 + G x (G[:, l] = A^(L-1-l) B), one small
+    product per frame. An unfinished frame is zero-padded and kept: the next call completes it. Every product has
+    the same shape whatever the caller's blocks, and the padding only adds exact zeros (T is lower-triangular), so a
+    record cut into any blocks is bit-identical to the record in one call.
+    """
+
+    def __init__(self, a, b, c, d: float, state: np.ndarray):
+        b, c = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (b, c))
+        a = np.asarray(a, dtype=float).reshape(b.size, b.size)
+        frame = FRAME
+        powers = np.empty((frame + 1, b.size, b.size))
+        powers[0] = np.eye(b.size)
+        for j in range(frame):
+            powers[j + 1] = a @ powers[j]
+        h = np.concatenate([[d], c @ powers[:frame - 1] @ b])
+        lag = np.arange(frame)[:, None] - np.arange(frame)[None, :]
+        self.toeplitz = np.where(lag >= 0, h[np.clip(lag, 0, None)], 0.0)     # (L, L)
+        self.carry = c @ powers[:frame]                                         # (L, n): C A^j
+        self.drive = (powers[frame - 1::-1] @ b).T.copy()                       # (n, L): A^(L-1-l) B
+        self.a_frame = powers[frame]
+        self.state = np.array(state, dtype=float).reshape(b.size, -1)          # at the start of the open frame
+        self.pending = np.empty((0, self.state.shape[1]))                       # inputs of the open frame
+
+    def apply(self, x: np.ndarray) -> np.ndarray:
+        """Filter the next samples ``x`` (count, axes) of the record."""
+        frame, axes = FRAME, self.state.shape[1]
+        done, total = self.pending.shape[0], self.pending.shape[0] + x.shape[0]
+        full = total // frame
+        frames = np.zeros((-(-total // frame), frame, axes))
+        flat = frames.reshape(-1, axes)
+        flat[:done], flat[done:total] = self.pending, x
+        drive = np.matmul(self.drive, frames[:full])                            # (full, n, axes)
+        starts = np.empty((frames.shape[0],) + self.state.shape)
+        s = self.state
+        for f in range(full):
+            starts[f] = s
+            s = self.a_frame @ s + drive[f]
+        if full < frames.shape[0]:
+            starts[full] = s
+        self.state = s
+        self.pending = flat[full * frame:total].copy()
+        y = np.matmul(self.toeplitz, frames) + np.matmul(self.carry, starts)
+        return y.reshape(-1, axes)[done:total]
+
+
+# Frames per batch of :class:`ShapedNoise`: noise is drawn and filtered in batches aligned to the record start.
+BATCH_FRAMES = 64
+
+
+class ShapedNoise:
+    """Unit white noise w through n first-order filters sharing it, s_i[k] = a_i s_i[k-1] + b_i w[k], summed as
+    y[k] = sum_i c_i s_i[k-1] + d w[k], on ``axes`` independent axes (state (n, axes)).
+
+    The :class:`FrameFilter` products without its frame-to-frame loop: the noise is drawn and filtered in whole
+    batches of :data:`BATCH_FRAMES` frames aligned to the record start and handed out from a buffer, so the
+    frame-start states of a batch follow in closed form (s0 of frame f = sum_{g<f} a^(L (f-1-g)) G w_g
+    + a^(L f) s0 of the batch, one (C x C) product per state) and every product has one shape whatever the
+    caller's blocks: a record cut into any blocks is bit-identical to the record in one call.
+    """
+
+    def __init__(self, a, b, c, d: float, state: np.ndarray, rng: np.random.Generator):
+        a, b, c = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (a, b, c))
+        frame, count = FRAME, BATCH_FRAMES
+        pw = a[None, :] ** np.arange(frame + 1)[:, None]                   # (L + 1, n): a^j
+        h = np.concatenate([[d], pw[:frame - 1] @ (c * b)])
+        lag = np.arange(frame)[:, None] - np.arange(frame)[None, :]
+        self.toeplitz = np.where(lag >= 0, h[np.clip(lag, 0, None)], 0.0)  # (L, L)
+        self.carry = pw[:frame] * c                                          # (L, n): c a^j
+        self.drive = (pw[frame - 1::-1] * b).T.copy()                        # (n, L): a^(L-1-l) b
+        a_frame = pw[frame]
+        steps = np.arange(count)[:, None] - np.arange(count)[None, :] - 1   # f - 1 - g
+        self.scan = np.where(steps >= 0, a_frame[:, None, None] ** np.clip(steps, 0, None), 0.0)  # (n, C, C)
+        self.from_start = (a_frame[:, None] ** np.arange(count)[None, :])[:, :, None]           # (n, C, 1)
+        self.to_end = (a_frame[:, None] ** np.arange(count - 1, -1, -1)[None, :])[:, None, :]   # (n, 1, C)
+        self.a_batch = a_frame ** count
+        self.state = np.array(state, dtype=float).reshape(a.size, -1)
+        self.rng = rng
+        self.ready = np.empty((0, self.state.shape[1]))
+
+    def _batch(self) -> np.ndarray:
+        axes = self.state.shape[1]
+        frame, count = FRAME, BATCH_FRAMES
+        w = self.rng.standard_normal((count, frame, axes))               # sample-major: the stream's order
+        drive = np.matmul(self.drive, w).transpose(1, 0, 2)                 # (n, C, axes)
+        starts = np.matmul(self.scan, drive) + self.from_start * self.state[:, None, :]
+        self.state = self.a_batch[:, None] * self.state + np.matmul(self.to_end, drive)[:, 0]
+        y = np.matmul(self.toeplitz, w) + np.matmul(self.carry, starts.transpose(1, 0, 2))
+        return y.reshape(count * frame, axes)
+
+    def block(self, count: int) -> np.ndarray:
+        parts, have = [self.ready], self.ready.shape[0]
+        while have < count:
+            parts.append(self._batch())
+            have += parts[-1].shape[0]
+        merged = np.concatenate(parts) if len(parts) > 1 else self.ready
+        self.ready = merged[count:].copy()
+        return merged[:count]
+
+
+def gauss_markov(sigma: float, tau_s: float, dt: float, rng: np.random.Generator, axes: int = 3) -> ShapedNoise:
+    """First-order Gauss-Markov bias of standard deviation ``sigma`` and correlation time ``tau_s``, started from its
+    stationary distribution: the exact AR(1) recursion of :func:`simkit.processes.ar1_coefficients`."""
+    from ..processes import ar1_coefficients
+
+    phi, drive = ar1_coefficients(sigma, tau_s, dt)
+    return ShapedNoise(phi, drive, phi, drive, sigma * rng.standard_normal(axes), rng)
+
+
+class Flicker(ShapedNoise):
     """Bias instability as flicker (1/f) noise of IEEE coefficient ``b`` over correlation times [tau_min, tau_max].
 
     Sum of first-order Gauss-Markov branches sharing one white noise (see :func:`flicker_design`): one normal
@@ -94,33 +200,14 @@ class Flicker:
 
     def __init__(self, b: float, tau_min: float, tau_max: float, dt: float, rng: np.random.Generator,
                  axes: int = 3):
-        p, self.c = flicker_design(b, tau_min, tau_max, dt)
-        self.phi = np.exp(-p * dt)
-        self.u = -np.expm1(-p * dt) / p / math.sqrt(dt)
+        p, c = flicker_design(b, tau_min, tau_max, dt)
+        phi = np.exp(-p * dt)
+        u = -np.expm1(-p * dt) / p / math.sqrt(dt)
         cov = 1.0 / (p[:, None] + p[None, :])       # stationary covariance of the branches, unit white input
         vals, vecs = np.linalg.eigh(cov)
         root = vecs * np.sqrt(np.clip(vals, 0.0, None))
-        self.state = root @ rng.standard_normal((p.size, axes))
-        self.rng = rng
-
-    def block(self, count: int) -> np.ndarray:
-        w = self.rng.standard_normal((count, self.state.shape[1]))
-        out = np.empty_like(w)
-        _flicker_kernel(w, self.phi, self.u, self.c, self.state, out)
-        return out
-
-
-@numba.njit(cache=True)
-def _quantize_kernel(v, step, residual, out):  # pragma: no cover - compiled
-    n, axes = v.shape
-    for a in range(axes):
-        r = residual[a]
-        for k in range(n):
-            x = r + v[k, a]
-            q = math.floor(x / step + 0.5) * step
-            r = x - q
-            out[k, a] = q
-        residual[a] = r
+        state = root @ rng.standard_normal((p.size, axes))
+        super().__init__(phi, u, c * phi, float(np.dot(c, u)), state, rng)
 
 
 class Quantizer:
@@ -135,20 +222,40 @@ class Quantizer:
         self.residual = np.zeros(axes)
 
     def block(self, increments: np.ndarray) -> np.ndarray:
+        from .kernels import quantize  # compiled: only a quantizing IMU starts numba
+
         out = np.empty_like(increments)
-        _quantize_kernel(np.ascontiguousarray(increments), self.step, self.residual, out)
+        quantize(np.ascontiguousarray(increments), self.step, self.residual, out)
         return out
+
+
+def butter2_lowpass(cutoff_hz: float, dt: float) -> np.ndarray:
+    """Second-order Butterworth low-pass at ``cutoff_hz`` for samples every ``dt`` s, bilinear transform with the
+    cut-off pre-warped: one second-order section [b0, b1, b2, 1, a1, a2] (scipy's sos layout, unity DC gain).
+
+    Closed form of H(s) = 1 / (s^2 + sqrt(2) s + 1) with s -> (1 - 1/z) / (K (1 + 1/z)), K = tan(pi f_c dt);
+    equal to ``scipy.signal.butter(2, f_c, fs=1/dt, output="sos")`` to rounding, without importing scipy.signal
+    (about 1 s of CPU at start-up).
+    """
+    k = math.tan(math.pi * cutoff_hz * dt)
+    k2 = k * k
+    norm = 1.0 + math.sqrt(2.0) * k + k2
+    b0 = k2 / norm
+    return np.array([b0, 2.0 * b0, b0, 1.0, 2.0 * (k2 - 1.0) / norm, (1.0 - math.sqrt(2.0) * k + k2) / norm])
 
 
 class LowPass:
     """Second-order Butterworth low-pass at ``cutoff_hz`` (bilinear, pre-warped), started in steady state."""
 
     def __init__(self, cutoff_hz: float, dt: float):
-        self.sos = signal.butter(2, cutoff_hz, fs=1.0 / dt, output="sos")
-        self.zi = None
+        self.sos = butter2_lowpass(cutoff_hz, dt)
+        self.filter = None
 
     def block(self, x: np.ndarray) -> np.ndarray:
-        if self.zi is None:
-            self.zi = signal.sosfilt_zi(self.sos)[:, :, None] * x[:1][None, :, :]
-        y, self.zi = signal.sosfilt(self.sos, x, axis=0, zi=self.zi)
-        return y
+        if self.filter is None:  # transposed direct form II as a state-space filter, at rest on the input x[0]
+            b0, b1, b2, _, a1, a2 = self.sos
+            a = np.array([[-a1, 1.0], [-a2, 0.0]])
+            b = np.array([b1 - a1 * b0, b2 - a2 * b0])
+            steady = np.linalg.solve(np.eye(2) - a, b)
+            self.filter = FrameFilter(a, b, np.array([1.0, 0.0]), b0, steady[:, None] * x[:1])
+        return self.filter.apply(np.asarray(x, dtype=float))

@@ -15,10 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..processes import GaussMarkov
 from ..rng import generator
 from .config import VIBRATION_KEYS, ImuConfig, SensorSpec
-from .noise import Flicker, LowPass, Quantizer, RandomWalk, WhiteNoise
+from .noise import Flicker, LowPass, Quantizer, RandomWalk, WhiteNoise, gauss_markov
 from .vibration import Vibration
 
 
@@ -93,7 +92,7 @@ class _Sensor:
             self.bias_sources.append(RandomWalk(s.rate_random_walk, dt, rng("rate_random_walk")))
         for i, gm in enumerate(s.gauss_markov):
             if gm.sigma > 0:
-                self.bias_sources.append(GaussMarkov(gm.sigma, gm.tau_s, dt, (3,), rng("gauss_markov", str(i))))
+                self.bias_sources.append(gauss_markov(gm.sigma, gm.tau_s, dt, rng("gauss_markov", str(i))))
         self.white = WhiteNoise(s.random_walk, dt, rng("white")) if s.random_walk > 0 else None
         self.vibration = (Vibration(np.array(s.vibration_psd), dt, rng("vibration"),
                                     f"imu.{name}.{VIBRATION_KEYS[name][0]}") if s.vibration_psd else None)

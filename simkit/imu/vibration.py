@@ -13,7 +13,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import fft, signal
 
 from ..errors import ScenarioError
 
@@ -59,8 +58,10 @@ def design(table: np.ndarray, fs: float, key: str) -> np.ndarray:
     if taps > MAX_TAPS:
         raise ScenarioError(key, f"lowest frequency {table[0, 0]:g} Hz is too low for the {fs:g} Hz IMU rate "
                                  f"(needs a {taps}-tap filter, at most {MAX_TAPS}): raise it")
+    from scipy.signal import firwin2  # here: scipy.signal costs ~1 s of start-up, and most runs have no vibration
+
     grid = np.linspace(0.0, nyquist, 1 + (1 << int(math.ceil(math.log2(taps)))))
-    h = signal.firwin2(taps, grid, np.sqrt(psd_at(table, grid) * nyquist), fs=fs)
+    h = firwin2(taps, grid, np.sqrt(psd_at(table, grid) * nyquist), fs=fs)
     return h * math.sqrt(band_variance(table).sum() / np.sum(h * h))
 
 
@@ -74,6 +75,8 @@ class Vibration:
     """
 
     def __init__(self, table: np.ndarray, dt: float, rng: np.random.Generator, key: str, axes: int = 3):
+        from scipy import fft  # here: only a vibrating IMU needs it
+
         self.h = design(np.asarray(table, dtype=float), 1.0 / dt, key)
         self.rng, self.axes = rng, axes
         taps = self.h.size
@@ -86,6 +89,8 @@ class Vibration:
     def _next_frame(self) -> np.ndarray:
         w = np.concatenate([self.history, self.rng.standard_normal((self.frame, self.axes))])
         self.history = w[self.frame:]
+        from scipy import fft
+
         y = fft.irfft(fft.rfft(w, self.nfft, axis=0) * self.kernel, self.nfft, axis=0)
         return y[self.h.size - 1:self.h.size - 1 + self.frame]
 

@@ -25,14 +25,22 @@ def _column(values) -> np.ndarray:
 
 
 def _common_shapes(run_files, paths) -> dict:
-    """path -> (shape, dtype str) for the paths that have one shape and dtype in every file."""
-    common = None
+    """path -> (shape, dtype str) for the paths that have one shape and dtype in every file (each file walked
+    once: opening every path by name cost the campaign's client 0.06 s per run file)."""
+    wanted, common = set(paths), None
     for fn in run_files:
+        here = {}
+
+        def visit(name, obj, here=here):
+            if name in wanted and isinstance(obj, h5py.Dataset):
+                dtype = obj.dtype
+                if h5py.check_string_dtype(dtype) is None:
+                    here[name] = (obj.shape, dtype.str)
+
         with h5py.File(fn, "r") as f:
-            here = {p: (f[p].shape, f[p].dtype.str) for p in paths
-                    if isinstance(f.get(p), h5py.Dataset) and h5py.check_string_dtype(f[p].dtype) is None}
+            f.visititems(visit)
         common = here if common is None else {p: v for p, v in common.items() if here.get(p) == v}
-    return common or {}
+    return {p: common[p] for p in paths if p in common} if common else {}
 
 
 def write_campaign_index(path, columns: dict[str, list], run_files: list, stack=()) -> list[str]:
@@ -49,10 +57,11 @@ def write_campaign_index(path, columns: dict[str, list], run_files: list, stack=
                 spec = schema.check(f"campaign/runs/{name}", data.dtype if data.dtype.kind != "O" else "U1",
                                     data.shape)
                 f.create_dataset(f"campaign/runs/{name}", data=data).attrs["units"] = spec.units
+            sources = [os.path.relpath(fn, path.parent) for fn in run_files]
             for p, (shape, dtype) in _common_shapes(run_files, stack).items():
                 layout = h5py.VirtualLayout(shape=(len(run_files),) + shape, dtype=np.dtype(dtype))
-                for i, fn in enumerate(run_files):
-                    layout[i] = h5py.VirtualSource(os.path.relpath(fn, path.parent), p, shape=shape)
+                for i, source in enumerate(sources):
+                    layout[i] = h5py.VirtualSource(source, p, shape=shape)
                 name = f"campaign/virtual/{p.replace('/', '.')}"
                 schema.check(name, np.dtype(dtype), (len(run_files),) + shape)
                 f.create_virtual_dataset(name, layout, fillvalue=None)

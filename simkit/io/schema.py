@@ -12,6 +12,7 @@ filter's extra output.
 """
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 
@@ -204,6 +205,7 @@ class SchemaError(ValueError):
     """A path, dtype or shape that schema version 1 does not declare."""
 
 
+@functools.lru_cache(maxsize=4096)  # a campaign index checks the same few hundred paths for every run
 def field(path: str) -> Field:
     """The declared :class:`Field` of a concrete dataset path (leading '/' optional)."""
     path = path.lstrip("/")

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field, replace
 from datetime import datetime
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import tomli_w
@@ -20,11 +20,13 @@ import tomli_w
 from .. import gpstime
 from ..errors import ScenarioError
 from ..params import parse_value
-from ..environment import EnvironmentConfig, check_antennas, parse_config as parse_environment
-from ..gnss import GnssConfig, parse_config as parse_gnss
-from ..imu import ImuConfig, parse_config as parse_imu
+from ..imu.config import ImuConfig, parse_config as parse_imu
 from ..section import Section, positive
 from ..trajectory import TrajectoryConfig, parse_config as parse_trajectory
+
+if TYPE_CHECKING:
+    from ..environment import EnvironmentConfig
+    from ..gnss import GnssConfig
 
 _INDEX = re.compile(r"^([A-Za-z_][\w-]*)(?:\[(\d+)\])?$")
 
@@ -171,6 +173,8 @@ def _validate(data: dict, base_dir: Path | None = None) -> Scenario:
             raise ScenarioError("imu.rate_hz", f"must equal trajectory.rate_hz ({traj.rate_hz:g}): the truth is "
                                 f"generated at the IMU rate, got {rate:g}")
     if root.has("gnss"):
+        from ..gnss import parse_config as parse_gnss  # here: the GNSS stage's imports cost a truth + IMU run 0.5 s
+
         gnss = parse_gnss(root.section("gnss"))
         ratio = traj.rate_hz / gnss.rate_hz
         if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
@@ -180,6 +184,8 @@ def _validate(data: dict, base_dir: Path | None = None) -> Scenario:
     if root.has("environment"):
         if gnss is None:
             raise ScenarioError("environment", "needs a [gnss] section: the environment acts on its signals")
+        from ..environment import check_antennas, parse_config as parse_environment
+
         env = parse_environment(root.section("environment"), (traj.lat_rad, traj.lon_rad, traj.height_m), base_dir)
         check_antennas(env, np.array([a.lever_arm_b for a in gnss.antennas]))
     root.done()

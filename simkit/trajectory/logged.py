@@ -28,7 +28,6 @@ from scipy.spatial.transform import Rotation
 from .. import earth, frames
 from ..earth import G0
 from ..errors import DataFileError
-from . import pspline
 from .truth import TrajectoryTruth, body_rate_nb
 
 ATTITUDE_RULES = ("log", "ground", "coordinated")
@@ -154,6 +153,14 @@ def check_jumps(track: Track, opts: FitOptions, sigma_m) -> None:
                                  f"(plus 6 sigma of noise)", int(track.line[k + 1]))
 
 
+def _pspline():
+    """:mod:`.pspline`, imported on first use: its scipy modules cost every run 0.2 s, and only a logged trajectory
+    needs them."""
+    from . import pspline
+
+    return pspline
+
+
 def _sigmas(track, local, opts):
     """Per-sample position sigmas (K, 3) and the per-axis figure used (stated, logged or estimated)."""
     if opts.position_sigma_m is not None:
@@ -162,7 +169,7 @@ def _sigmas(track, local, opts):
     elif track.sigma_enu is not None and np.all(np.isfinite(track.sigma_enu)):
         sig, how = np.array(track.sigma_enu, float), "logged"
     else:
-        est = np.array([pspline.noise_sigma(track.t, local[:, i]) for i in range(3)])
+        est = np.array([_pspline().noise_sigma(track.t, local[:, i]) for i in range(3)])
         if not np.all(np.isfinite(est)):
             raise DataFileError(track.source, "cannot estimate the position noise (no runs of evenly spaced "
                                               "samples): give trajectory.position_sigma_m")
@@ -199,7 +206,7 @@ class LoggedPath:
                                               f"but the run needs 0 to {duration_s:g} s: move scenario.start or "
                                               f"shorten scenario.duration_s")
         spacing = float(np.median(np.diff(t)))
-        self.knots = pspline.knots(t[0], t[-1], spacing)
+        self.knots = _pspline().knots(t[0], t[-1], spacing)
         self._fit_positions(track, local, sig, opts)
         self.att_splines = None
         if self.rule == "log":
@@ -234,7 +241,7 @@ class LoggedPath:
             ok = np.isfinite(vel_l[:, i]) if vel_l is not None else np.zeros(len(t), bool)
             if ok.any():                         # (RMC and VTG give no vertical velocity)
                 kw = dict(xv=t[ok], v=vel_l[ok, i], sigma_v=np.maximum(sig_v[ok, i], 1e-4))
-            s, lam, chi2 = pspline.smooth(self.knots, t, local[:, i], sig[:, i], **kw)
+            s, lam, chi2 = _pspline().smooth(self.knots, t, local[:, i], sig[:, i], **kw)
             self.splines.append(s)
             self.lam.append(lam)
             self.chi2.append(chi2)
@@ -245,9 +252,9 @@ class LoggedPath:
         angles[:, 2] = np.unwrap(angles[:, 2])
         self.att_splines = []
         for i in range(3):
-            sa = opts.attitude_sigma_rad or pspline.noise_sigma(track.t, angles[:, i])
+            sa = opts.attitude_sigma_rad or _pspline().noise_sigma(track.t, angles[:, i])
             sa = max(sa if np.isfinite(sa) else 0.0, _SIGMA_FLOOR_RAD)
-            self.att_splines.append(pspline.smooth(self.knots, track.t, angles[:, i], np.full(len(track.t), sa))[0])
+            self.att_splines.append(_pspline().smooth(self.knots, track.t, angles[:, i], np.full(len(track.t), sa))[0])
 
     def _slowest(self, grid):
         """(the lowest horizontal speed of the fitted path on ``grid`` (m/s), its index)."""
@@ -270,7 +277,7 @@ class LoggedPath:
         pitch = np.arctan2(v[moving, 2], vh[moving])
         angles = np.stack([np.interp(t, t[moving], pitch), np.zeros_like(t), np.interp(t, t[moving], heading)], -1)
         sigma = HELD_SIGMA_RAD * np.where(moving, np.maximum(1.0, HELD_SPEED_M_PER_S / np.maximum(vh, 1e-9)), 1.0)
-        self.att_splines = [pspline.smooth(self.knots, t, angles[:, i], sigma)[0] for i in range(3)]
+        self.att_splines = [_pspline().smooth(self.knots, t, angles[:, i], sigma)[0] for i in range(3)]
         self.held_epochs = int((~moving).sum())
 
     def summary(self) -> dict:

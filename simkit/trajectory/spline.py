@@ -10,7 +10,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import make_interp_spline
 
 
 def unit_velocity(gamma, psi):
@@ -29,6 +28,8 @@ class WaypointPath:
     @classmethod
     def build(cls, start, points, v_start, speed_end):
         """``v_start``: entry velocity (ENU m/s); ``speed_end``: exit speed; exit direction along the last leg."""
+        from scipy.interpolate import make_interp_spline  # here: only waypoint segments need scipy.interpolate
+
         pts = np.vstack([np.zeros(3), np.asarray(points, dtype=float)])
         legs = np.linalg.norm(np.diff(pts, axis=0), axis=1)
         v0 = float(np.linalg.norm(v_start))

@@ -1,0 +1,213 @@
+"""Benchmark: truth + IMU, 600 s at 1 kHz, end to end (interpreter start-up, imports, generation, file write), against
+gnss-ins-sim doing the same job in the same run.
+
+Ours: ``python -m simkit run`` on the high_dynamic flight (5-7 g turns, 200+ deg/s rolls, a loop) at 1 kHz with the
+STIM300 IMU (turn-on bias, flicker bias instability, ARW/VRW, scale factor, misalignment, g-sensitivity, 262 Hz
+bandwidth, range), no GNSS, into one HDF5 file: truth (8 datasets), IMU (gyro, accel) and every error term.
+The peer (github.com/Aceinna/gnss-ins-sim, not on PyPI; a checkout from ``--peer`` or ``$GNSS_INS_SIM``) in a fresh
+interpreter: ``ins_sim.Sim`` on a motion profile of turns, 200 deg/s rolls and a climbing acceleration at the same
+rate, with the STIM300's bias, ARW/VRW and bias instability (first-order Gauss-Markov, its model), ``run()`` and
+``results(dir)``, its own output (CSV files). Both are timed as child processes: wall time and CPU time
+(user + system of the child, so threads count). Also printed: the peer's generation alone in memory (``path_gen``
++ ``gyro_gen`` + ``acc_gen``, no start-up, no file), the strictest comparison.
+
+    python benchmarks/bench_truth_imu.py [--seconds 600] [--rate 1000] [--peer DIR] [--json OUT]
+    python benchmarks/bench_truth_imu.py --ab OLD_TREE NEW_TREE [--rounds 3]     (before / after, no peer)
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import peers  # noqa: E402  (benchmarks/peers.py)
+import timing  # noqa: E402
+
+# gnss-ins-sim: turns, 200 deg/s rolls and a climbing acceleration (type 1 rows: yaw, pitch, roll rates in deg/s,
+# body accelerations in m/s^2, duration s, GPS visibility), the cycle of bench_truth.py
+PEER_CYCLE = [(1, 0, 0, 0, 0, 0, 0, 2.0, 0), (1, 30, 0, 0, 0, 0, 0, 6.0, 0), (1, 0, 0, 200, 0, 0, 0, 1.8, 0),
+              (1, 0, 5, 0, 1, 0, 0, 3.0, 0)]
+PEER = r"""
+import contextlib, io, sys
+import numpy as np
+sys.path.insert(0, sys.argv[1])
+from gnss_ins_sim.sim import imu_model, ins_sim
+seconds, rate, out = float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
+cycle = %r
+rows = cycle * max(1, round(seconds / sum(r[7] for r in cycle)))
+motion = "ini lat,ini lon,ini alt,vx,vy,vz,yaw,pitch,roll\n40,116,4000,200,0,0,0,0,0\n" \
+         "type,yaw,pitch,roll,vx,vy,vz,t,gps\n" + "\n".join(",".join(str(v) for v in r) for r in rows)
+g = 9.80665
+stim300 = {"gyro_b": np.full(3, 250.0), "gyro_arw": np.full(3, 0.15), "gyro_b_stability": np.full(3, 0.3),
+           "gyro_b_corr": np.full(3, 100.0), "accel_b": np.full(3, 0.75e-3 * g), "accel_vrw": np.full(3, 0.06),
+           "accel_b_stability": np.full(3, 0.05e-3 * g), "accel_b_corr": np.full(3, 100.0)}
+imu = imu_model.IMU(accuracy=stim300, axis=6, gps=False)
+sim = ins_sim.Sim([rate, 0.0, 0.0], motion, ref_frame=0, imu=imu, mode=np.array([100.0, 5000.0, 500.0]))
+with contextlib.redirect_stdout(io.StringIO()):
+    sim.run(1)
+    sim.results(out)
+print(sim.dmgr.time.data.size)
+""" % (PEER_CYCLE,)
+
+
+def child(cmd: list[str], cwd: Path | None = None) -> tuple[float, float, str]:
+    """(wall s, CPU s of the child and its threads, stdout) of one command."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    out = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if out.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd[:4])} ...: exit {out.returncode}\n{out.stderr[-2000:]}")
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, out.stdout
+
+
+def scenario(seconds: float, rate: float) -> str:
+    """high_dynamic without GNSS, at ``rate`` Hz for ``seconds``, with the STIM300 IMU (TOML text)."""
+    import tomli_w
+
+    data = tomllib.loads((ROOT / "scenarios" / "high_dynamic.toml").read_text())
+    data.pop("gnss")
+    data["scenario"]["duration_s"] = seconds
+    data["trajectory"]["rate_hz"] = rate
+    data["imu"] = {"preset": "stim300"}
+    return tomli_w.dumps(data)
+
+
+def ours(tmp: Path, seconds: float, rate: float) -> tuple[float, float, int]:
+    """(wall s, CPU s, file bytes) of ``python -m simkit run`` in a fresh interpreter (this checkout)."""
+    path = tmp / "truth_imu.toml"
+    path.write_text(scenario(seconds, rate))
+    out = tmp / "truth_imu.h5"
+    wall, cpu, _ = child([sys.executable, "-m", "simkit", "run", str(path), "-o", str(out), "-q"], cwd=ROOT)
+    return wall, cpu, out.stat().st_size
+
+
+def theirs(tmp: Path, checkout: Path, seconds: float, rate: float) -> tuple[float, float, int, int]:
+    """(wall s, CPU s, bytes written, samples) of gnss-ins-sim's Sim.run + results in a fresh interpreter."""
+    out = tmp / "peer"
+    out.mkdir()
+    wall, cpu, stdout = child([sys.executable, "-c", PEER, str(checkout), str(seconds), str(rate), str(out)])
+    size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    return wall, cpu, size, int(stdout.split()[-1])
+
+
+def theirs_in_memory(pathgen, seconds: float, rate: float) -> float:
+    """Samples/s of path_gen + gyro_gen + acc_gen in this process (no start-up, no file): CPU time."""
+    import numpy as np
+
+    d2r = np.pi / 180.0
+    initial = np.array([40.0 * d2r, 116.0 * d2r, 4000.0, 200.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    rows = PEER_CYCLE * max(1, round(seconds / sum(r[7] for r in PEER_CYCLE)))
+    motion = np.array(rows, dtype=float)
+    motion[:, 1:4] *= d2r
+    gyro_err = {"b": np.full(3, 250.0 / 3600 * d2r), "b_drift": np.full(3, 0.3 / 3600 * d2r),
+                "b_corr": np.full(3, 100.0), "arw": np.full(3, 0.15 / 60 * d2r)}
+    acc_err = {"b": np.full(3, 7.4e-3), "b_drift": np.full(3, 4.9e-4), "b_corr": np.full(3, 100.0),
+               "vrw": np.full(3, 0.06 / 60)}
+    c0 = time.process_time()
+    res = pathgen.path_gen(initial, motion, np.array([[1.0, rate], [-1.0, rate], [-1.0, rate]]),
+                           np.array([100.0, 5000.0 * d2r, 500.0 * d2r]), ref_frame=0)
+    pathgen.gyro_gen(rate, res["imu"][:, 4:7], gyro_err)
+    pathgen.acc_gen(rate, res["imu"][:, 1:4], acc_err)
+    return res["nav"].shape[0] / (time.process_time() - c0)
+
+
+AB_PROBE = r"""
+import resource, subprocess, sys, time
+tree, scenario = sys.argv[1], sys.argv[2]
+t0 = time.perf_counter()
+subprocess.run([sys.executable, "-m", "simkit", "run", scenario, "-o", scenario + ".h5", "-q"], cwd=tree, check=True)
+r = resource.getrusage(resource.RUSAGE_CHILDREN)
+print(f"{time.perf_counter() - t0:.2f} {r.ru_utime + r.ru_stime:.2f}")
+"""
+
+
+def ab(trees, seconds: float, rate: float, rounds: int) -> None:
+    """``python -m simkit run`` of the same scenario in each tree, alternating (timing.ab): wall and CPU s."""
+    with tempfile.TemporaryDirectory(prefix="bench_truth_imu_ab_") as tmp:
+        path = Path(tmp) / "truth_imu.toml"
+        path.write_text(scenario(seconds, rate))
+        timing.ab(trees, AB_PROBE, ["wall s", "CPU s"], rounds, path, own_cache=True)
+
+
+def measure(seconds: float = 600.0, rate: float = 1000.0, peer: str | None = None) -> dict:
+    """Every figure of this benchmark, measured in this run (the peer's are None without a checkout)."""
+    n = int(round(seconds * rate)) + 1
+    load = os.getloadavg()[0]
+    with tempfile.TemporaryDirectory(prefix="bench_truth_imu_") as tmp:
+        tmp = Path(tmp)
+        child([sys.executable, "-m", "simkit", "run", "--help"], cwd=ROOT)      # warm the page cache, not numba
+        wall, cpu, size = ours(tmp, seconds, rate)
+        result = {"samples": n, "seconds": seconds, "rate_hz": rate, "load_before": load,
+                  "ours": {"wall_s": wall, "cpu_s": cpu, "bytes": size},
+                  "peer": None, "peer_in_memory_samples_per_s": None}
+        pathgen = peers.gnss_ins_sim(peer)
+        if pathgen is not None:
+            checkout = Path(pathgen.__file__).resolve().parents[2]
+            pw, pc, psize, pn = theirs(tmp, checkout, seconds, rate)
+            result["peer"] = {"wall_s": pw, "cpu_s": pc, "bytes": psize, "samples": pn}
+            result["peer_in_memory_samples_per_s"] = theirs_in_memory(pathgen, min(seconds, 60.0), rate)
+    result["load_after"] = os.getloadavg()[0]
+    return result
+
+
+def report(r: dict) -> list[tuple[str, str, str, str]]:
+    """(figure, ours, peer, ratio) rows."""
+    n = r["samples"]
+    o = r["ours"]
+    rows = [(f"truth + IMU, {r['seconds']:g} s at {r['rate_hz'] / 1000:g} kHz, start-up + write, wall",
+             f"{o['wall_s']:.2f} s ({n / o['wall_s']:,.0f} samples/s)"),
+            ("truth + IMU, CPU (user + system)", f"{o['cpu_s']:.2f} s")]
+    out = []
+    p = r["peer"]
+    for (name, ours_text), key in zip(rows, ("wall_s", "cpu_s")):
+        if p is None:
+            out.append((name, ours_text, "peer absent", "-"))
+            continue
+        ours_rate, peer_rate = n / o[key], p["samples"] / p[key]
+        out.append((name, ours_text, f"{p[key]:.1f} s ({peer_rate:,.0f} samples/s)", f"{ours_rate / peer_rate:.1f}x"))
+    if r["peer_in_memory_samples_per_s"]:
+        peer_rate = r["peer_in_memory_samples_per_s"]
+        out.append(("same, against the peer's generation alone (in memory, no start-up, no file; CPU)",
+                    f"{n / o['cpu_s']:,.0f} samples/s", f"{peer_rate:,.0f} samples/s",
+                    f"{n / o['cpu_s'] / peer_rate:.1f}x"))
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=600.0)
+    ap.add_argument("--rate", type=float, default=1000.0)
+    ap.add_argument("--peer", help="gnss-ins-sim checkout (default: $GNSS_INS_SIM)")
+    ap.add_argument("--json", help="also write the figures as JSON to this file")
+    ap.add_argument("--ab", nargs=2, metavar=("A", "B"), help="time two checkouts against each other instead")
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args(argv)
+    if args.ab:
+        ab(args.ab, args.seconds, args.rate, args.rounds)
+        return 0
+    r = measure(args.seconds, args.rate, args.peer)
+    print(f"{r['samples']:,} samples ({args.seconds:g} s at {args.rate:g} Hz), load average "
+          f"{r['load_before']:.2f} before, {r['load_after']:.2f} after; simkit file {r['ours']['bytes'] / 1e6:.0f} MB"
+          + (f", gnss-ins-sim CSV {r['peer']['bytes'] / 1e6:.0f} MB" if r["peer"] else
+             "; gnss-ins-sim not found (--peer DIR or GNSS_INS_SIM=DIR): no peer figure"))
+    timing.print_table(["figure", "simkit", "gnss-ins-sim", "ratio"], report(r))
+    if args.json:
+        Path(args.json).write_text(json.dumps(r, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
