@@ -51,4 +51,4 @@ def test_light_time_solution_equals_the_converged_light_time_equation(systems):
     dr = np.abs(geo.range - rng)[known].max()
     dc = np.abs(geo.sat_clock - clk)[known].max()
     print(f"\n{systems}: max |position| {dp:.1e} m, |range| {dr:.1e} m, |clock| {dc:.1e} s")
-    assert dp < 1e-6 and dr < 1e-6 and dc < 1e-15
+    assert dp < 3e-7 and dr < 1e-7 and dc < 1e-15   # range: 5e-7 cycles at L1
