@@ -80,10 +80,9 @@ def _member(k, w, phase, sin_a, cos_a, x, x0, t, dt, reach):
 
 
 @numba.njit(cache=True, fastmath=_SUM)
-def _clusters(k, w, phase, x, t, dt, out):
+def _clusters(k, w, phase, reach, x, t, dt, out):
     n_feat = k.shape[1]
     sin_a, cos_a = np.empty(n_feat), np.empty(n_feat)
-    reach = np.array([np.sqrt((k * k).sum(axis=0)).max(), np.abs(w).max(), np.abs(phase).max()])
     base = x.shape[2] // 2
     for m in range(x.shape[0]):
         for c in range(x.shape[3]):
@@ -106,8 +105,10 @@ def feature_sums(k, w, phase, x, t, dt) -> np.ndarray:
 
     The cluster of point (m, 0, J // 2, c) is every (m, a, j, c): antennas ``a`` and time offsets ``j`` of one
     satellite ``c`` at epoch ``m``. Returns (M, A, J, C); NaN where a point or its base is not finite."""
+    k = np.ascontiguousarray(np.asarray(k, dtype=float).T)
+    w, phase = np.ascontiguousarray(w, dtype=float), np.ascontiguousarray(phase, dtype=float)
+    reach = np.array([np.sqrt((k * k).sum(axis=0)).max(), np.abs(w).max(), np.abs(phase).max()])
     out = np.empty(x.shape[:-1])
-    _clusters(np.ascontiguousarray(np.asarray(k, dtype=float).T), np.ascontiguousarray(w, dtype=float),
-              np.ascontiguousarray(phase, dtype=float), np.ascontiguousarray(x, dtype=float),
-              np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(dt, dtype=float), out)
+    _clusters(k, w, phase, reach, np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(t, dtype=float),
+              np.ascontiguousarray(dt, dtype=float), out)
     return out
