@@ -14,45 +14,49 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit import earth, frames, gpstime
+from simkit import frames, gpstime
 from simkit.constellation import load_sky
-from simkit.constellation.sources import DEFAULT_SKY, resolve
-from simkit.gnss import GnssSimulator, parse_config
-from simkit.section import Section
+from simkit.constellation.sources import resolve
+from simkit.gnss import GnssSimulator
+from simkit.scenario import load
+from simkit.trajectory import Trajectory
 
 START = (2416, 86400.0)  # 2026-04-27 00:00 GPST, the day of the BRDM file
 ORIGIN = np.radians([34.2, 108.9])
+BRDM = "BRDM00DLR_S_20261170000_01D_MN.rnx.gz"
+SIGNALS = ["L1C", "L2W", "B1I", "B3I"]
 
 
 def sky_source() -> str:
     try:
-        return str(resolve(DEFAULT_SKY))
+        return str(resolve(BRDM))
     except Exception:
         return "nominal:gps+bds"
 
 
+def scenario(hours: float):
+    """xian_static_bds on 27 Apr 2026 with the bundled broadcast file, GPS + BDS, two signals per satellite."""
+    return load("xian_static_bds", [f"scenario.duration_s={hours * 3600:g}",
+                                    'scenario.start="2026-04-27T00:00:00Z"',
+                                    f"gnss.constellation[0].source={sky_source()!r}",
+                                    f"gnss.signals={SIGNALS!r}"])
+
+
 def ours(hours: float, block: int = 600):
-    table = {"rate_hz": 1.0, "signals": ["L1C", "L2W", "B1I", "B3I"], "constellation": [{"source": sky_source()}],
-             "clock": "per_antenna", "slip_rate_per_h": 0.5,
-             "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0]}, {"lever_arm_m": [3.965, 0.0, 0.0]},
-                         {"lever_arm_m": [0.0, 9.445, 0.0]}]}
-    cfg = parse_config(Section(table, "gnss"))
-    t0 = time.perf_counter()
-    sim = GnssSimulator(cfg, load_sky(cfg.sources), *START, seed=1, duration_s=hours * 3600.0)
-    t = sim.epoch_times()
-    pos = frames.lla_to_ecef(ORIGIN[0], ORIGIN[1], 400.0)
-    rot = frames.attitude_from_euler(0.0, 0.0, 0.5)
-    w_ib = rot.inv().apply(earth.earth_rate_enu(ORIGIN[0]))
-    n_obs = 0
-    for i in range(0, t.size, block):
-        tb = t[i:i + block]
-        m = tb.size
-        out = sim.process(tb, np.tile(pos, (m, 1)), np.zeros((m, 3)), np.tile(rot.as_quat(), (m, 1)),
-                          np.tile(w_ib, (m, 1)))
-        for sig in cfg.signals:
+    """(wall s, CPU s, epochs, satellites, observations) of the observables stage, blocks of ``block`` epochs,
+    as the pipeline runs it (sky of the scenario's systems, trajectory truth at the GNSS rate)."""
+    sc = scenario(hours)
+    t0, c0 = time.perf_counter(), time.process_time()
+    sky = load_sky(sc.gnss.sources, sc.gnss.nav_systems)
+    sim = GnssSimulator(sc.gnss, sky, sc.start_week, sc.start_sow, sc.seed, sc.duration_s)
+    n_obs = m = 0
+    for truth in Trajectory(sc.trajectory, sc.duration_s).blocks(rate_hz=sc.gnss.rate_hz, block_samples=block):
+        out = sim.process(truth.t, truth.pos_ecef, truth.vel_ecef(), truth.quat_nb, truth.omega_ib_b)
+        for sig in sc.gnss.signals:
             n_obs += int(np.isfinite(out.obs[sig].carrier).sum())
+        m += truth.t.size
         del out
-    return time.perf_counter() - t0, t.size, len(sim.sat_ids), n_obs
+    return time.perf_counter() - t0, time.process_time() - c0, m, len(sim.sat_ids), n_obs
 
 
 def peer(epochs: int = 60):
@@ -97,13 +101,15 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hours", type=float, default=24.0)
     args = ap.parse_args()
-    sec, m, s, n_obs = ours(args.hours)
+    ours(0.05)  # compiled kernels loaded, caches warm: the figure is the steady state
+    sec, cpu, m, s, n_obs = ours(args.hours)
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    triples = n_obs / 4 * 2  # observations of one signal pair ~ (epoch, antenna, tracked satellite) triples
-    print(f"simkit gnss: {args.hours:g} h at 1 Hz = {m} epochs, {s} satellites (GPS+BDS), 3 antennas, 2 signals "
-          f"per satellite: {sec:.1f} s ({n_obs / sec / 1e6:.2f} M observations/s); peak RSS {rss:.0f} MB")
+    triples = n_obs / 2  # two signals per satellite: (epoch, antenna, tracked satellite) triples
+    print(f"simkit gnss: xian_static_bds {args.hours:g} h at 1 Hz = {m} epochs, {s} satellites (GPS+BDS, {BRDM}), "
+          f"3 antennas, 2 signals per satellite: {sec:.1f} s wall, {cpu:.1f} s CPU ({n_obs / sec / 1e6:.2f} M "
+          f"observations/s); peak RSS {rss:.0f} MB")
     if args.hours == 24.0:
-        print(f"  target < 20 s: {'PASS' if sec < 20 else 'FAIL'}")
+        print(f"  target < 10 s: {'PASS' if sec < 10 else 'FAIL'} (wall), {'PASS' if cpu < 10 else 'FAIL'} (CPU)")
     try:
         per = peer()
     except Exception as exc:  # the peer is optional
@@ -112,12 +118,12 @@ def main():
     if per is None:
         print("gnss-lib-py peer not run: no RINEX navigation file")
         return
-    peer_sec = per * triples / 2
+    peer_sec = per * triples
     print(f"gnss-lib-py simulate_measures (GPS code + Doppler, 1 signal, no error terms): {per * 1e6:.1f} us per "
-          f"(epoch, satellite); the same {triples / 2:.3g} (epoch, antenna, satellite) triples would take "
+          f"(epoch, satellite); the same {triples:.3g} (epoch, antenna, satellite) triples would take "
           f"{peer_sec:.0f} s")
-    print(f"ratio peer / simkit: {peer_sec / sec:.1f}x (simkit also produces carrier, C/N0, LLI, a second signal "
-          f"and every error term)")
+    print(f"ratio peer / simkit: {peer_sec / sec:.1f}x (wall; simkit also produces carrier, C/N0, LLI, a second "
+          f"signal and every error term)")
 
 
 if __name__ == "__main__":

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from .. import gpstime
@@ -271,6 +272,15 @@ class KeplerConstellation(Constellation):
                 raise ValueError(f"{sat_ids[s]}: records with different repeat periods")
             self._sel.append((rows, toe[rows], records.half_width[rows], per[0] if per.size else np.inf,
                               bool(after[rows].all()) if rows.size else False))
+        # the same tables flattened for the selection kernel: satellite s owns entries bounds[s]:bounds[s + 1]
+        self._flat = (np.concatenate([x[0] for x in self._sel]).astype(np.int64) if self._sel else
+                      np.zeros(0, np.int64),
+                      np.concatenate([x[1] for x in self._sel]).astype(float) if self._sel else np.zeros(0),
+                      np.concatenate([x[2] for x in self._sel]).astype(float) if self._sel else np.zeros(0),
+                      np.cumsum([0] + [x[0].size for x in self._sel]).astype(np.int64),
+                      np.array([x[3] for x in self._sel], dtype=float),
+                      np.array([x[4] for x in self._sel], dtype=bool),
+                      np.array([x[1][0] if x[0].size else 0.0 for x in self._sel]))
 
     @property
     def channels(self) -> np.ndarray:
@@ -280,26 +290,13 @@ class KeplerConstellation(Constellation):
         """Record index (N, S) for times ``t`` (N, S) (GPS s since ``ref_week``, column s for satellite s): the
         healthy record with the nearest toe (the later one on a tie) whose validity covers t; -1 where none.
         Also returns the times to evaluate at (``t`` moved by whole periods for repeating almanac records)."""
-        idx = np.full(t.shape, -1, dtype=np.int64)
+        rows, toe, half, bounds, period, after, first = self._flat
         t_eval = np.array(t, dtype=float)
-        for s, (rows, toe, half, period, after) in enumerate(self._sel):
-            if rows.size == 0:
-                continue
-            ts = t_eval[:, s]  # a view: shifting it shifts t_eval
-            if np.isfinite(period):
-                ts -= period * np.round((ts - toe[0]) / period)
-            if after:  # the latest toe strictly before t, up to half_width after it
-                j = np.searchsorted(toe, ts, side="left") - 1
-                pick = np.maximum(j, 0)
-                ok = (j >= 0) & (ts - toe[pick] <= half[pick])
-                idx[:, s] = np.where(ok, rows[pick], -1)
-                continue
-            j = np.searchsorted(toe, ts, side="right")  # toe[j-1] <= t < toe[j]
-            lo = np.clip(j - 1, 0, rows.size - 1)
-            hi = np.clip(j, 0, rows.size - 1)
-            pick = np.where(np.abs(toe[hi] - ts) <= np.abs(ts - toe[lo]), hi, lo)
-            ok = np.abs(ts - toe[pick]) <= half[pick]
-            idx[:, s] = np.where(ok, rows[pick], -1)
+        rep = np.isfinite(period)
+        if rep.any():  # repeating records: the copy nearest to each time
+            t_eval[:, rep] -= period[rep] * np.round((t_eval[:, rep] - first[rep]) / period[rep])
+        idx = np.empty(t_eval.shape, dtype=np.int64)
+        _select(rows, toe, half, bounds, after, np.ascontiguousarray(t_eval), idx)
         return idx, t_eval
 
     def _intervals(self):
@@ -313,6 +310,30 @@ class KeplerConstellation(Constellation):
     def _evaluate(self, t, velocity):
         idx, t_eval = self.select(t)
         return kepler.propagate(self.records.params, idx.ravel(), t_eval.ravel(), velocity)
+
+
+@numba.njit(cache=True)
+def _select(rows, toe, half, bounds, after, t, idx):
+    """Record index per (time, satellite) (see :meth:`KeplerConstellation.select`): satellite s's healthy records
+    are ``rows[bounds[s]:bounds[s + 1]]`` sorted by ``toe``, valid ``half`` s either side (``after[s]``: only after,
+    the latest toe strictly before t)."""
+    for s in range(t.shape[1]):
+        lo_s, hi_s = bounds[s], bounds[s + 1]
+        for n in range(t.shape[0]):
+            idx[n, s] = -1
+            if hi_s == lo_s:
+                continue
+            ts = t[n, s]
+            if after[s]:  # np.searchsorted(toe, ts, side="left") - 1
+                j = lo_s + np.searchsorted(toe[lo_s:hi_s], ts) - 1
+                if j >= lo_s and ts - toe[j] <= half[j]:
+                    idx[n, s] = rows[j]
+                continue
+            j = lo_s + np.searchsorted(toe[lo_s:hi_s], ts, side="right")  # toe[j-1] <= t < toe[j]
+            lo, hi = max(j - 1, lo_s), min(j, hi_s - 1)
+            pick = hi if abs(toe[hi] - ts) <= abs(ts - toe[lo]) else lo
+            if abs(ts - toe[pick]) <= half[pick]:
+                idx[n, s] = rows[pick]
 
 
 class CombinedConstellation(Constellation):

@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import earth, rng
 from .atmosphere import broadcast_ionosphere, reference_frequency
+from .feature_sum import feature_sums
 from .ionex import IONO_CONSTANT, TECU, IonexMaps, slant_factor
 
 SHELL_HEIGHT_M = 350e3            # thin-shell height of the random field's pierce points
@@ -66,6 +67,12 @@ class ResidualField:
             out[i:i + chunk] = np.cos(arg).sum(axis=-1)
         return self.scale * out.reshape(shape)
 
+    def clusters(self, x, t, dt):
+        """e at points ``x`` (M, A, J, C, 3) m close to (m, 0, J // 2, c) (antennas and time steps of one satellite,
+        metres apart) at times ``t`` (M,) + ``dt`` (J,) s: :func:`simkit.gnss.feature_sum.feature_sums`, equal to
+        :meth:`__call__` within 1e-13."""
+        return self.scale * feature_sums(self.k, self.w, self.phase, x, t, dt)
+
 
 class TruthIonosphere:
     """Truth ionospheric delay at a system's reference frequency (L1 for GPS, B1I for BDS): ``fraction`` the RMS
@@ -83,28 +90,33 @@ class TruthIonosphere:
     def delay(self, system, alpha, beta, lla, vel_enu, az, el, az_rate, el_rate, week, sow, t, h: float = 0.05):
         """(truth, truth rate, Klobuchar) in m and m/s for receivers at ``lla`` (M, A, 3) moving at ``vel_enu``
         (M, A, 3) m/s, satellites at ``az``/``el`` (M, A, C) rad with rates in rad/s, GPS ``week``/``sow`` and
-        ``t`` s since the start, each (M, 1, 1)."""
+        ``t`` s since the start, each (M, 1, 1) (one time per epoch)."""
         lat, lon, hgt = lla[..., 0, None], lla[..., 1, None], lla[..., 2, None]
         rm, rn = earth.radii(lat)
         lat_rate = vel_enu[..., 1, None] / (rm + hgt)
         lon_rate = vel_enu[..., 0, None] / ((rn + hgt) * np.cos(lat))
-
-        def at(s):
+        steps = (-h, 0.0, h)
+        klob, points = [], []
+        for s in steps:
             la, lo, a, e = lat + s * lat_rate, lon + s * lon_rate, az + s * az_rate, el + s * el_rate
-            klob = broadcast_ionosphere(system, alpha, beta, la, lo, a, e, sow + s)
+            klob.append(broadcast_ionosphere(system, alpha, beta, la, lo, a, e, sow + s))
             if self.ionex is not None:
                 m = self.ionex
                 lat_p, lon_p = pierce_point(la, lo, a, e, m.base_radius_m, m.height_m)
                 tec = m.vtec(week, sow + s, lat_p, lon_p) * slant_factor(e, m.base_radius_m, m.height_m)
-                return IONO_CONSTANT * TECU * tec / reference_frequency(system) ** 2, klob
-            if self.field is None:
-                return klob, klob
-            lat_p, lon_p = pierce_point(la, lo, a, e)
-            r = SHELL_RADIUS_M + SHELL_HEIGHT_M
-            x = np.stack([r * np.cos(lat_p) * np.cos(lon_p), r * np.cos(lat_p) * np.sin(lon_p),
-                          r * np.sin(lat_p)], axis=-1)
-            return klob * np.exp(self.sigma * self.field(x, t + s) - 0.5 * self.sigma**2), klob
-
-        truth, klob = at(0.0)
-        rate = (at(h)[0] - at(-h)[0]) / (2.0 * h)
-        return truth, rate, klob
+                points.append(IONO_CONSTANT * TECU * tec / reference_frequency(system) ** 2)
+            elif self.field is not None:
+                lat_p, lon_p = pierce_point(la, lo, a, e)
+                r = SHELL_RADIUS_M + SHELL_HEIGHT_M
+                points.append(np.stack([r * np.cos(lat_p) * np.cos(lon_p), r * np.cos(lat_p) * np.sin(lon_p),
+                                        r * np.sin(lat_p)], axis=-1))
+        if self.ionex is not None:
+            truth = points
+        elif self.field is not None:
+            shape = klob[1].shape
+            epoch_t = np.broadcast_to(np.asarray(t, dtype=float), shape)[:, 0, 0]
+            e = self.field.clusters(np.stack(points, axis=2), epoch_t, np.array(steps))       # (M, A, 3, C)
+            truth = [k * np.exp(self.sigma * e[:, :, j] - 0.5 * self.sigma**2) for j, k in enumerate(klob)]
+        else:
+            truth = klob
+        return truth[1], (truth[2] - truth[0]) / (2.0 * h), klob[1]

@@ -53,9 +53,16 @@ def body_los(sat_pos_ecef, rx_pos_ecef, quat_nb) -> tuple[np.ndarray, np.ndarray
     return np.einsum("mij,msj->msi", C_bn, u_enu), el
 
 
-def from_scenario(sc, progress: bool = False) -> ValidationGeometry:
+BLOCK_EPOCHS = 3600  # epochs of sky geometry at a time: peak memory ~ BLOCK_EPOCHS x satellites x 1 kB
+
+
+def from_scenario(sc, progress: bool = False, block_epochs: int = BLOCK_EPOCHS) -> ValidationGeometry:
     """Geometry of scenario ``sc`` (a loaded :class:`simkit.scenario.Scenario`) at its GNSS rate: trajectory truth
-    and the sky of ``sc.gnss.sources``; visible = elevation at or above ``sc.gnss.elevation_mask_rad``."""
+    and the sky of ``sc.gnss.sources``; visible = elevation at or above ``sc.gnss.elevation_mask_rad``.
+
+    Streamed: the light-time geometry (several (M, S, 3) arrays) is computed ``block_epochs`` epochs at a time
+    and only the lines of sight, elevations and visibility of the whole run are kept; every epoch is computed
+    on its own, so the result does not depend on the block size."""
     from ..constellation import load_sky
     from ..trajectory import Trajectory
 
@@ -65,15 +72,18 @@ def from_scenario(sc, progress: bool = False) -> ValidationGeometry:
         raise ValidationInputError(f"{sc.source or sc.name}: gnss.antenna: expected at least 2 antennas (a "
                                    f"baseline), found {len(sc.gnss.antennas)}")
     traj = Trajectory(sc.trajectory, sc.duration_s)
-    truth = list(traj.blocks(rate_hz=sc.gnss.rate_hz))
-    t = np.concatenate([b.t for b in truth])
-    pos = np.concatenate([b.pos_ecef for b in truth])
-    quat = np.concatenate([b.quat_nb for b in truth])
-    week, sow = gpstime.add_seconds(sc.start_week, sc.start_sow, t)
     sky = load_sky(sc.gnss.sources, sc.gnss.nav_systems)
-    with np.errstate(invalid="ignore"):
-        view = sky.view(pos, week, sow)
-    los, el = body_los(view["sat_pos"], pos, quat)
+    m, n_sat = traj.n_samples(sc.gnss.rate_hz), len(sky.sat_ids)
+    t, los, el = np.empty(m), np.empty((m, n_sat, 3)), np.empty((m, n_sat))
+    k = 0
+    for block in traj.blocks(rate_hz=sc.gnss.rate_hz, block_samples=block_epochs):
+        rows = slice(k, k + block.t.size)
+        week, sow = gpstime.add_seconds(sc.start_week, sc.start_sow, block.t)
+        with np.errstate(invalid="ignore"):
+            sat_pos = sky.view(block.pos_ecef, week, sow)["sat_pos"]
+        t[rows] = block.t
+        los[rows], el[rows] = body_los(sat_pos, block.pos_ecef, block.quat_nb)
+        k += block.t.size
     with np.errstate(invalid="ignore"):
         vis = np.isfinite(el) & (el >= sc.gnss.elevation_mask_rad)
     arms = np.array([a.lever_arm_b for a in sc.gnss.antennas], dtype=float)
