@@ -2,7 +2,8 @@
 satellite (GPS L1C + L2W, BDS B1I + B3I), processed in blocks of 600 epochs (bounded memory).
 
 Peer: gnss-lib-py's ``simulate_measures`` (code and Doppler only, GPS only, one receiver, no error terms),
-timed on a short span of the same day and scaled to the same number of (epoch, antenna, satellite) triples.
+timed on a short span of the same day and scaled to the same number of (epoch, antenna, satellite) triples. It runs
+in its own interpreter (``GNSS_LIB_PY_PYTHON``; see ``peer_gnss_lib_py.py`` for why).
 Run: ``python benchmarks/bench_gnss.py [--hours H]``.
 """
 from __future__ import annotations
@@ -60,41 +61,30 @@ def ours(hours: float, block: int = 600):
 
 
 def peer(epochs: int = 60):
-    """gnss-lib-py: seconds per (epoch, satellite) for code + Doppler of one GPS receiver."""
-    import warnings
-
-    from gnss_lib_py.navdata.navdata import NavData
-    from gnss_lib_py.parsers.rinex_nav import RinexNav
-    from gnss_lib_py.utils.gnss_models import simulate_measures
+    """gnss-lib-py: seconds per (epoch, satellite) for code + Doppler of one GPS receiver, run by
+    ``peer_gnss_lib_py.py`` in the interpreter ``GNSS_LIB_PY_PYTHON`` names (default: this one)."""
+    import gzip
+    import os
+    import subprocess
+    import sys
+    import tempfile
 
     nav_path = sky_source()
-    if nav_path.endswith(".gz") or nav_path.startswith("nominal:"):
-        import gzip
-        import tempfile
-
-        if nav_path.startswith("nominal:"):
-            return None
+    if nav_path.startswith("nominal:"):
+        return None
+    if nav_path.endswith(".gz"):
         tmp = Path(tempfile.mkdtemp()) / Path(nav_path).with_suffix("").name
         tmp.write_bytes(gzip.open(nav_path).read())
         nav_path = str(tmp)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        ephem = RinexNav(nav_path, satellites=[f"G{k:02d}" for k in range(1, 33)])
     pos = frames.lla_to_ecef(ORIGIN[0], ORIGIN[1], 400.0)
-    state = NavData()
-    for name, v in zip(("x_rx_m", "y_rx_m", "z_rx_m", "vx_rx_mps", "vy_rx_mps", "vz_rx_mps", "b_rx_m",
-                        "b_dot_rx_mps"), list(pos) + [0.0] * 5):
-        state[name] = np.array([v])
-    rng = np.random.default_rng(0)
     ms0 = (START[0] * gpstime.SECONDS_PER_WEEK + START[1] + 3600.0) * 1000.0
-    n_sv = 0
-    t0 = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        for k in range(epochs):
-            meas, _ = simulate_measures(ms0 + 1000.0 * k, state, ephem=ephem, rng=rng, el_mask=10.0)
-            n_sv += len(meas)
-    return (time.perf_counter() - t0) / max(n_sv, 1)
+    python = os.environ.get("GNSS_LIB_PY_PYTHON", sys.executable)
+    out = subprocess.run([python, str(Path(__file__).with_name("peer_gnss_lib_py.py")), nav_path,
+                          *map(repr, map(float, pos)), repr(ms0), str(epochs)], capture_output=True, text=True)
+    if out.returncode != 0:
+        raise RuntimeError(f"{python}: {out.stderr.strip().splitlines()[-1] if out.stderr.strip() else 'failed'} "
+                           f"(give an interpreter with gnss-lib-py in GNSS_LIB_PY_PYTHON)")
+    return float(out.stdout.split()[-1])
 
 
 def main():
