@@ -22,7 +22,8 @@ from ..earth import C_LIGHT
 from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
-from . import fidelity, importer
+from ..constellation.geometry import angles_from_enu, lines_of_sight_enu
+from . import fidelity, horizon, importer
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -90,6 +91,8 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
                                "correlation_time_s": p["mp_correlation_time_s"]}},
+        **({"environment": {"reflections": False, "body_mask": [dict(p["horizon_mask"])]}}
+           if p.get("horizon_mask") else {}),
     }
 
 
@@ -310,15 +313,38 @@ def toml_fragment(p: dict) -> str:
              f"correlation_time_s = {p['mp_correlation_time_s']:.1f}", "",
              "[gnss.code_error_scale]", *(f"{k} = {v:.4f}" for k, v in p.get("code_error_scale", {}).items()), "",
              "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]", f"rolloff_db = {p['rolloff_db']:.2f}"]
+    if p.get("horizon_mask"):
+        tab = p["horizon_mask"]
+        lines += ["", "# the station's horizon profile (a level antenna facing north: body azimuth = azimuth)",
+                  "[environment]", "reflections = false", "", "[[environment.body_mask]]",
+                  f"azimuth_deg = [{', '.join(f'{a:g}' for a in tab['azimuth_deg'])}]",
+                  f"elevation_deg = [{', '.join(f'{e:g}' for e in tab['elevation_deg'])}]"]
     return "\n".join(lines) + "\n"
 
 
-def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress):
+def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress, arrays=False):
     from ..pipeline import run
 
     run(scenario(real, ref, nav_paths, mask, params, seed), out=path, progress=progress, force=True)
     twin = file_arrays(path)
-    return compare(on_twin_grid(real, twin), twin, ref, mask)
+    on_grid = on_twin_grid(real, twin)
+    result = compare(on_grid, twin, ref, mask)
+    return (result, on_grid, twin) if arrays else result
+
+
+def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> dict:
+    """The horizon profile (:mod:`.horizon`) from the real tracking on the twin's grid and the twin's geometry
+    (``twin`` simulated without a profile): the ``[[environment.body_mask]]`` table, its in-sample agreement and
+    the agreement fitted on one half of the epochs and checked on the other."""
+    rx = np.broadcast_to(np.asarray(reference, float), (twin["t"].size, 3))
+    with np.errstate(invalid="ignore"):
+        el, az = angles_from_enu(lines_of_sight_enu(rx, twin["sat_pos"])[0])
+    real_on, twin_on = fidelity.tracked(real_on_grid["obs"]), fidelity.tracked(twin["obs"])
+    floor = np.radians(mask_deg)
+    table = horizon.mask_table(horizon.profile(el, az, real_on, floor, simulated=twin_on))
+    return {"table": table, "sector_deg": horizon.SECTOR_DEG,
+            "in_sample": horizon.agreement(el, az, real_on, twin_on, floor, table),
+            "holdout": horizon.holdout(el, az, real_on, twin_on, floor)}
 
 
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
@@ -340,10 +366,13 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
     result = {"obs": Path(obs_path).name, "nav": [Path(n).name for n in nav_paths],
               "reference": imported.report["reference"], "epochs": int(real["t"].size),
               "span_s": float(real["t"][-1]), "signals": real["signals"], "seed": seed}
-    result["default"] = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed, out_dir / "twin.h5", progress)
+    result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
+                                                      out_dir / "twin.h5", progress, arrays=True)
     if fit:
         fitted = fit_parameters(real, ref)
         result["fit_notes"] = fitted.pop("_notes")
+        result["horizon"] = fit_horizon(real_grid, twin0, ref, mask)
+        fitted["horizon_mask"] = result["horizon"]["table"]
         fitted = rescale(fitted, result["default"])    # carrier and Doppler terms from the default twin
         first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, out_dir / "twin_fit.h5", progress)
         fitted = rescale(fitted, first)                # one refinement of the per-signal code factors
