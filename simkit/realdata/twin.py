@@ -22,6 +22,7 @@ from ..earth import C_LIGHT
 from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
+from ..gnss.config import code_scale_at
 from ..constellation.geometry import angles_from_enu, lines_of_sight_enu
 from . import fidelity, horizon, importer
 
@@ -87,7 +88,8 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                  "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0], "rolloff_db": p["rolloff_db"]}],
                  "noise": {"dll_bandwidth_hz": p["dll_bandwidth_hz"], "pll_bandwidth_hz": p["pll_bandwidth_hz"],
                            "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
-                 "code_error_scale": dict(p.get("code_error_scale", {})),
+                 "code_error_scale": {k: {"elevation_deg": list(v[0]), "factor": list(v[1])}
+                                      if isinstance(v, tuple) else v for k, v in p.get("code_error_scale", {}).items()},
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
                                "correlation_time_s": p["mp_correlation_time_s"]}},
@@ -255,8 +257,28 @@ def rescale(p: dict, result: dict) -> dict:
     scales = dict(p.get("code_error_scale", {}))
     for s, ratios in result["code_noise_ratio"].items():
         ok = [x for x in ratios if x]
-        if ok:
+        if ok and not isinstance(scales.get(s), tuple):
             scales[s] = float(scales.get(s, 1.0) / np.median(ok))
+    p["code_error_scale"] = scales
+    return p
+
+
+def code_tables(p: dict, result: dict) -> dict:
+    """``p`` with each signal's code factor turned into a table over the elevation bins' centres: the factor
+    there divided by the twin / real code-noise ratio of that bin in the twin run ``result`` (made with ``p``);
+    a bin without a ratio takes the signal's median ratio. Code noise and code multipath are both linear in the
+    factor, so one step moves every bin onto the real sigma up to the two files' sampling scatter."""
+    p = dict(p)
+    edges = np.asarray(result["elevation_bins_deg"], float)
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    scales = dict(p.get("code_error_scale", {}))
+    for s, ratios in result["code_noise_ratio"].items():
+        ok = [x for x in ratios if x]
+        if not ok:
+            continue
+        now = np.broadcast_to(code_scale_at(scales.get(s, 1.0), np.radians(centres)), centres.shape)
+        r = np.array([x if x else np.median(ok) for x in ratios])
+        scales[s] = (tuple(float(c) for c in centres), tuple(float(f) for f in now / r))
     p["code_error_scale"] = scales
     return p
 
@@ -311,7 +333,8 @@ def toml_fragment(p: dict) -> str:
              f"carrier_sigma_m = {p['mp_carrier_sigma_m']:.5f}",
              f"elevation_scale_deg = {p['mp_elevation_scale_deg']:.2f}",
              f"correlation_time_s = {p['mp_correlation_time_s']:.1f}", "",
-             "[gnss.code_error_scale]", *(f"{k} = {v:.4f}" for k, v in p.get("code_error_scale", {}).items()), "",
+             "[gnss.code_error_scale]", *(f"{k} = {_scale_toml(v)}" for k, v in p.get("code_error_scale", {}).items()),
+             "",
              "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]", f"rolloff_db = {p['rolloff_db']:.2f}"]
     if p.get("horizon_mask"):
         tab = p["horizon_mask"]
@@ -320,6 +343,13 @@ def toml_fragment(p: dict) -> str:
                   f"azimuth_deg = [{', '.join(f'{a:g}' for a in tab['azimuth_deg'])}]",
                   f"elevation_deg = [{', '.join(f'{e:g}' for e in tab['elevation_deg'])}]"]
     return "\n".join(lines) + "\n"
+
+
+def _scale_toml(v) -> str:
+    if isinstance(v, tuple):
+        return (f"{{elevation_deg = [{', '.join(f'{e:g}' for e in v[0])}], "
+                f"factor = [{', '.join(f'{f:.4f}' for f in v[1])}]}}")
+    return f"{v:.4f}"
 
 
 def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress, arrays=False):
@@ -347,6 +377,52 @@ def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> d
             "holdout": horizon.holdout(el, az, real_on, twin_on, floor)}
 
 
+def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
+    """The fitted parameters of ``real`` (:func:`fit_parameters`, the horizon profile, then the carrier, Doppler
+    and code terms scaled from a default and a first calibrated twin, and the code factors made tables over
+    elevation), the fit's notes and the horizon dict; ``default`` = (comparison, real on the grid, twin arrays)
+    of a default twin already run on ``real``."""
+    if default is None:
+        default = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed, path, progress, arrays=True)
+    fitted = fit_parameters(real, ref)
+    notes = fitted.pop("_notes")
+    hz = fit_horizon(default[1], default[2], ref, mask)
+    fitted["horizon_mask"] = hz["table"]
+    fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
+    first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
+    tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
+    fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
+    return fitted, notes, hz
+
+
+def _rows(arr: dict, rows) -> dict:
+    """``arr`` (a twin or real dict) cut to the epochs ``rows`` (bool (M,))."""
+    return {**arr, "t": arr["t"][rows], "sat_pos": arr["sat_pos"][rows],
+            "obs": {k: {s: v[rows] for s, v in d.items()} for k, d in arr["obs"].items()}}
+
+
+def _holdout(real, ref, nav_paths, mask, seed, path, progress) -> dict:
+    """Out-of-sample check of the fit: every parameter (horizon profile and code tables included) fitted on the
+    first half of the epochs only, a twin of the whole span run with them, and the comparison on the second half
+    (neither the fit nor its twins saw it)."""
+    first_half = real["t"] < real["t"][0] + 0.5 * (real["t"][-1] - real["t"][0])
+    fitted, _, hz = _calibrate(_rows(real, first_half), ref, nav_paths, mask, seed + 10, path, progress)
+    from ..pipeline import run
+
+    run(scenario(real, ref, nav_paths, mask, fitted, seed + 12), out=path, progress=progress, force=True)
+    twin = file_arrays(path)
+    grid = on_twin_grid(real, twin)
+    second = twin["t"] >= real["t"][~first_half][0] - 1e-6
+    out = compare(_rows(grid, second), _rows(twin, second), ref, mask)
+    return {"fitted_on_s": [float(real["t"][first_half][0]), float(real["t"][first_half][-1])],
+            "checked_on_s": [float(twin["t"][second][0]), float(twin["t"][second][-1])],
+            "visibility_agreement": out["visibility_agreement"],
+            "satellite_epochs_above_mask": out["satellite_epochs_above_mask"],
+            "tracked_real_not_twin": out["tracked_real_not_twin"], "tracked_twin_not_real": out["tracked_twin_not_real"],
+            "code_noise_ratio": out["code_noise_ratio"], "real_code_noise_m": out["real"]["code_noise_m"],
+            "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": hz["table"]}
+
+
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
              reference_source=None, progress: bool = False) -> dict:
     """Import ``obs_path`` (+ ``nav_paths``), simulate its twin into ``out_dir``/twin.h5 (and with ``fit`` the
@@ -369,17 +445,14 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
     result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
                                                       out_dir / "twin.h5", progress, arrays=True)
     if fit:
-        fitted = fit_parameters(real, ref)
-        result["fit_notes"] = fitted.pop("_notes")
-        result["horizon"] = fit_horizon(real_grid, twin0, ref, mask)
-        fitted["horizon_mask"] = result["horizon"]["table"]
-        fitted = rescale(fitted, result["default"])    # carrier and Doppler terms from the default twin
-        first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, out_dir / "twin_fit.h5", progress)
-        fitted = rescale(fitted, first)                # one refinement of the per-signal code factors
+        fitted, notes, result["horizon"] = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5",
+                                                      progress, (result["default"], real_grid, twin0))
+        result["fit_notes"] = notes
         result["fitted_parameters"] = fitted
         (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
         result["fitted"] = _twin_once(real, ref, nav_paths, mask, fitted, seed + 2, out_dir / "twin_fit.h5",
                                       progress)
+        result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress)
     (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
     return result
 
