@@ -24,7 +24,7 @@ from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
 from ..gnss.config import code_scale_at
 from ..constellation.geometry import angles_from_enu, lines_of_sight_enu
-from . import fidelity, horizon, importer
+from . import fidelity, horizon, importer, ionosphere
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -43,7 +43,10 @@ def real_arrays(imported: importer.Imported) -> dict:
             "freq": d["gnss/frequency_hz"], "sat_pos": d["gnss/sat_pos_ecef"],
             "obs": {k: {s: d[f"gnss/obs/{s}/{k}"][:, 0] for s in signals} for k in KINDS},
             "reference": d.get("reference/pos_ecef"), "start": (int(imported.attrs["start_gps_week"]),
-                                                                 float(imported.attrs["start_gps_sow"]))}
+                                                                 float(imported.attrs["start_gps_sow"])),
+            "group_delay": d.get("gnss/group_delay"),
+            "iono": {str(k): (a, b) for k, a, b in zip(d.get("gnss/iono_systems", []), d.get("gnss/iono_alpha", []),
+                                                          d.get("gnss/iono_beta", []))}}
 
 
 def file_arrays(path) -> dict:
@@ -92,7 +95,9 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                                       if isinstance(v, tuple) else v for k, v in p.get("code_error_scale", {}).items()},
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
-                               "correlation_time_s": p["mp_correlation_time_s"]}},
+                               "correlation_time_s": p["mp_correlation_time_s"]},
+                 **({"truth_errors": {"iono_residual_fraction": p["iono_residual_fraction"]}}
+                    if p.get("iono_residual_fraction") is not None else {})},
         **({"environment": {"reflections": False, "body_mask": [dict(p["horizon_mask"])]}}
            if p.get("horizon_mask") else {}),
     }
@@ -235,6 +240,13 @@ def fit_parameters(real: dict, reference) -> dict:
         p["mp_correlation_time_s"] = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0))
     rates = [v for v in st["slips_per_hour"].values() if v is not None]
     p["slip_rate_per_h"] = float(np.mean(rates)) if rates else 0.0
+    if real.get("group_delay") is not None and real.get("iono"):
+        iono = ionosphere.klobuchar_ratio(real, reference, real["group_delay"], real["iono"])
+        p["_ionosphere"] = iono
+        p["iono_residual_fraction"] = ionosphere.residual_fraction(iono)
+    if p.get("iono_residual_fraction") is None:
+        notes.append("no dual-frequency GPS or BDS code and carrier with a Klobuchar model: the truth "
+                     "ionosphere's residual left at the default")
     p["_notes"] = notes
     return p
 
@@ -336,6 +348,9 @@ def toml_fragment(p: dict) -> str:
              "[gnss.code_error_scale]", *(f"{k} = {_scale_toml(v)}" for k, v in p.get("code_error_scale", {}).items()),
              "",
              "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]", f"rolloff_db = {p['rolloff_db']:.2f}"]
+    if p.get("iono_residual_fraction") is not None:
+        lines += ["", "# the real ionosphere against Klobuchar (dual-frequency geometry-free, carrier-levelled code)",
+                  "[gnss.truth_errors]", f"iono_residual_fraction = {p['iono_residual_fraction']:.4f}"]
     if p.get("horizon_mask"):
         tab = p["horizon_mask"]
         lines += ["", "# the station's horizon profile (a level antenna facing north: body azimuth = azimuth)",
@@ -380,19 +395,21 @@ def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> d
 def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     """The fitted parameters of ``real`` (:func:`fit_parameters`, the horizon profile, then the carrier, Doppler
     and code terms scaled from a default and a first calibrated twin, and the code factors made tables over
-    elevation), the fit's notes and the horizon dict; ``default`` = (comparison, real on the grid, twin arrays)
+    elevation), the fit's notes and {"horizon": :func:`fit_horizon`, "ionosphere": the Klobuchar comparison of
+    :func:`.ionosphere.klobuchar_ratio`}; ``default`` = (comparison, real on the grid, twin arrays)
     of a default twin already run on ``real``."""
     if default is None:
         default = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed, path, progress, arrays=True)
     fitted = fit_parameters(real, ref)
     notes = fitted.pop("_notes")
+    iono = fitted.pop("_ionosphere", None)
     hz = fit_horizon(default[1], default[2], ref, mask)
     fitted["horizon_mask"] = hz["table"]
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
     first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
     tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
     fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
-    return fitted, notes, hz
+    return fitted, notes, {"horizon": hz, "ionosphere": iono}
 
 
 def _rows(arr: dict, rows) -> dict:
@@ -406,7 +423,7 @@ def _holdout(real, ref, nav_paths, mask, seed, path, progress) -> dict:
     first half of the epochs only, a twin of the whole span run with them, and the comparison on the second half
     (neither the fit nor its twins saw it)."""
     first_half = real["t"] < real["t"][0] + 0.5 * (real["t"][-1] - real["t"][0])
-    fitted, _, hz = _calibrate(_rows(real, first_half), ref, nav_paths, mask, seed + 10, path, progress)
+    fitted, _, extras = _calibrate(_rows(real, first_half), ref, nav_paths, mask, seed + 10, path, progress)
     from ..pipeline import run
 
     run(scenario(real, ref, nav_paths, mask, fitted, seed + 12), out=path, progress=progress, force=True)
@@ -420,7 +437,8 @@ def _holdout(real, ref, nav_paths, mask, seed, path, progress) -> dict:
             "satellite_epochs_above_mask": out["satellite_epochs_above_mask"],
             "tracked_real_not_twin": out["tracked_real_not_twin"], "tracked_twin_not_real": out["tracked_twin_not_real"],
             "code_noise_ratio": out["code_noise_ratio"], "real_code_noise_m": out["real"]["code_noise_m"],
-            "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": hz["table"]}
+            "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": extras["horizon"]["table"],
+            "iono_residual_fraction": fitted.get("iono_residual_fraction")}
 
 
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
@@ -445,8 +463,9 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
     result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
                                                       out_dir / "twin.h5", progress, arrays=True)
     if fit:
-        fitted, notes, result["horizon"] = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5",
-                                                      progress, (result["default"], real_grid, twin0))
+        fitted, notes, extras = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5", progress,
+                                           (result["default"], real_grid, twin0))
+        result.update(extras)
         result["fit_notes"] = notes
         result["fitted_parameters"] = fitted
         (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
