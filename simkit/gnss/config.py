@@ -24,6 +24,7 @@ class Antenna:
     boresight_b: np.ndarray      # (3,) unit vector, body frame
     horizon_mask_rad: float      # satellites less than this above the antenna's horizon plane are masked
     rolloff_db: float            # gain at the antenna horizon relative to boresight (dB, >= 0)
+    gain_pattern: tuple | None = None   # ((off-boresight deg, ...), (gain dB, ...)): replaces the rolloff
 
 
 @dataclass(frozen=True)
@@ -155,11 +156,29 @@ def _signals(sec: Section) -> list[str]:
 
 
 def _antenna(a: Section) -> Antenna:
+    pattern = None
+    if a.has("gain_pattern"):
+        if a.has("rolloff_db"):
+            raise a.error("gain_pattern", "cannot be given with rolloff_db: the pattern replaces the rolloff")
+        pattern = _gain_pattern(a.section("gain_pattern"))
     return Antenna(
         lever_arm_b=np.asarray(a.get("lever_arm_m", float, shape=3)),
         boresight_b=_unit(a.get("boresight_b", float, [0.0, 0.0, 1.0], shape=3), a, "boresight_b"),
         horizon_mask_rad=np.radians(a.get("horizon_mask_deg", float, 0.0, check=in_range(-90.0, 90.0))),
-        rolloff_db=a.get("rolloff_db", float, 10.0, check=non_negative))
+        rolloff_db=a.get("rolloff_db", float, 10.0, check=non_negative), gain_pattern=pattern)
+
+
+def _gain_pattern(t: Section) -> tuple:
+    """``gain_pattern = {off_boresight_deg = [...], gain_db = [...]}``: the antenna gain relative to the zenith
+    C/N0 at increasing angles from the boresight in [0, 180] (linear in between, the end values beyond)."""
+    off = t.get("off_boresight_deg", float, shape=0)
+    gain = t.get("gain_db", float, shape=0)
+    if not off or len(off) != len(gain):
+        raise t.error("gain_db", f"expected one gain per angle ({len(off)}), got {len(gain)}")
+    if any(b <= a for a, b in zip(off, off[1:])) or not all(0.0 <= x <= 180.0 for x in off):
+        raise t.error("off_boresight_deg", f"expected increasing angles in [0, 180], got {off!r}")
+    t.done()
+    return tuple(off), tuple(gain)
 
 
 def _noise(nz: Section) -> NoiseConfig:

@@ -74,21 +74,29 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
     week, sow = real["start"]
     t = real["t"]
     interval = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    duration = float(np.floor(t[-1] / interval + 1e-6) * interval)   # on the twin's epoch grid
     start = gpstime.gps_to_utc(week, sow)
     lla = frames.ecef_to_lla(np.asarray(reference, float)[None])[0]
     p = {**DEFAULTS, **params}
+    if real.get("trajectory"):           # a moving receiver: the path of a log ([trajectory] source)
+        trajectory = {"rate_hz": 1.0 / interval, **real["trajectory"]}
+    else:
+        trajectory = {"rate_hz": 1.0 / interval,
+                      "origin": {"lat_deg": float(np.degrees(lla[0])), "lon_deg": float(np.degrees(lla[1])),
+                                 "height_m": float(lla[2])},
+                      "initial": {"speed_m_per_s": 0.0, "heading_deg": 0.0},
+                      "segment": [{"kind": "static", "duration_s": duration}]}
     return {
         "scenario": {"name": "twin", "start": start.isoformat(timespec="microseconds").replace("+00:00", "Z"),
-                     "duration_s": float(t[-1]), "seed": int(seed)},
-        "trajectory": {"rate_hz": 1.0 / interval,
-                       "origin": {"lat_deg": float(np.degrees(lla[0])), "lon_deg": float(np.degrees(lla[1])),
-                                  "height_m": float(lla[2])},
-                       "initial": {"speed_m_per_s": 0.0, "heading_deg": 0.0},
-                       "segment": [{"kind": "static", "duration_s": float(t[-1])}]},
+                     "duration_s": duration, "seed": int(seed)},
+        "trajectory": trajectory,
         "gnss": {"rate_hz": 1.0 / interval, "elevation_mask_deg": mask_deg, "signals": list(real["signals"]),
                  "cn0_zenith_dbhz": p["cn0_zenith_dbhz"], "slip_rate_per_h": p["slip_rate_per_h"],
                  "constellation": [{"source": str(Path(n).resolve())} for n in nav_paths],
-                 "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0], "rolloff_db": p["rolloff_db"]}],
+                 "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0],
+                              **({"gain_pattern": {"off_boresight_deg": list(p["gain_pattern"][0]),
+                                                   "gain_db": list(p["gain_pattern"][1])}}
+                                 if p.get("gain_pattern") else {"rolloff_db": p["rolloff_db"]})}],
                  "noise": {"dll_bandwidth_hz": p["dll_bandwidth_hz"], "pll_bandwidth_hz": p["pll_bandwidth_hz"],
                            "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
                  "code_error_scale": {k: {"elevation_deg": list(v[0]), "factor": list(v[1])}
@@ -220,6 +228,7 @@ def fit_parameters(real: dict, reference) -> dict:
         sol = np.linalg.lstsq(np.vstack(rows_x), np.concatenate(rows_y), rcond=None)[0]
         p["cn0_zenith_dbhz"] = float(np.clip(sol[0], 10.0, 70.0))
         p["rolloff_db"] = float(max(sol[1], 0.0))
+        p["gain_pattern"] = _gain_pattern(real, sigs, el, p)
     else:
         notes.append("no signal-strength observations: C/N0 model left at the defaults")
     edges = fidelity.ELEVATION_EDGES_DEG
@@ -249,6 +258,19 @@ def fit_parameters(real: dict, reference) -> dict:
                      "ionosphere's residual left at the default")
     p["_notes"] = notes
     return p
+
+
+def _gain_pattern(real, sigs, el, p) -> tuple:
+    """The antenna gain pattern (off-boresight deg, gain dB) of a level antenna (off-boresight = 90 deg -
+    elevation) at the elevation bins' centres: the mean of C/N0 minus each signal's offset over the bin, minus
+    the fitted zenith C/N0; bins without ``fidelity.by_elevation``'s minimum count take the quadratic rolloff."""
+    edges = fidelity.ELEVATION_EDGES_DEG
+    off = 90.0 - 0.5 * (edges[:-1] + edges[1:])
+    pooled = np.concatenate([real["obs"]["cn0"][g.name] - g.cn0_offset_db for g in sigs], axis=1)
+    mean = fidelity.by_elevation(pooled, np.tile(el, (1, len(sigs))))
+    gain = [m - p["cn0_zenith_dbhz"] if m is not None else -p["rolloff_db"] * (o / 90.0) ** 2
+            for m, o in zip(mean, off)]
+    return tuple(float(x) for x in off[::-1]), tuple(float(x) for x in gain[::-1])
 
 
 def rescale(p: dict, result: dict) -> dict:
@@ -347,7 +369,10 @@ def toml_fragment(p: dict) -> str:
              f"correlation_time_s = {p['mp_correlation_time_s']:.1f}", "",
              "[gnss.code_error_scale]", *(f"{k} = {_scale_toml(v)}" for k, v in p.get("code_error_scale", {}).items()),
              "",
-             "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]", f"rolloff_db = {p['rolloff_db']:.2f}"]
+             "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]",
+             f"rolloff_db = {p['rolloff_db']:.2f}" if not p.get("gain_pattern") else
+             f"gain_pattern = {{off_boresight_deg = [{', '.join(f'{x:g}' for x in p['gain_pattern'][0])}], "
+             f"gain_db = [{', '.join(f'{x:.2f}' for x in p['gain_pattern'][1])}]}}"]
     if p.get("iono_residual_fraction") is not None:
         lines += ["", "# the real ionosphere against Klobuchar (dual-frequency geometry-free, carrier-levelled code)",
                   "[gnss.truth_errors]", f"iono_residual_fraction = {p['iono_residual_fraction']:.4f}"]
@@ -403,8 +428,10 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     fitted = fit_parameters(real, ref)
     notes = fitted.pop("_notes")
     iono = fitted.pop("_ionosphere", None)
-    hz = fit_horizon(default[1], default[2], ref, mask)
-    fitted["horizon_mask"] = hz["table"]
+    hz = None
+    if not real.get("trajectory"):       # a horizon profile belongs to a fixed antenna
+        hz = fit_horizon(default[1], default[2], ref, mask)
+        fitted["horizon_mask"] = hz["table"]
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
     first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
     tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
@@ -437,28 +464,76 @@ def _holdout(real, ref, nav_paths, mask, seed, path, progress) -> dict:
             "satellite_epochs_above_mask": out["satellite_epochs_above_mask"],
             "tracked_real_not_twin": out["tracked_real_not_twin"], "tracked_twin_not_real": out["tracked_twin_not_real"],
             "code_noise_ratio": out["code_noise_ratio"], "real_code_noise_m": out["real"]["code_noise_m"],
-            "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": extras["horizon"]["table"],
+            "cn0_rms_difference_dbhz": out["cn0_rms_difference_dbhz"],
+            "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": (extras["horizon"] or {}).get("table"),
             "iono_residual_fraction": fitted.get("iono_residual_fraction")}
 
 
+def track_sigma_enu(pos_ecef, centre, window: int = 51) -> list:
+    """Position noise [east, north, up] (m) of a logged track: the robust standard deviation (1.4826 MAD) of its
+    samples about their running median over ``window`` samples (10 s of a 5 Hz log). A receiver's own SPP
+    errors are correlated over seconds, so the third differences the log fit estimates its noise from see only
+    a fraction of them, and the fitted path (and the attitude that follows its velocity) would keep them."""
+    from scipy.ndimage import median_filter
+
+    p = np.asarray(pos_ecef, float)
+    p = p[np.isfinite(p).all(axis=1)]
+    lla = frames.ecef_to_lla(np.asarray(centre, float)[None])[0]
+    enu = (p - centre) @ frames.ecef_to_enu_matrix(lla[0], lla[1]).T
+    r = enu - median_filter(enu, size=(min(window, len(enu)), 1), mode="nearest")
+    return [float(max(x, 0.01)) for x in 1.4826 * np.median(np.abs(r - np.median(r, axis=0)), axis=0)]
+
+
+def level_track_csv(rec, centre, name: str) -> str:
+    """The log ``rec`` (a :class:`simkit.logs.Record`) as the CSV log of a vehicle on level ground: its epochs
+    and horizontal positions, every height the median height, and the position noise of :func:`track_sigma_enu`
+    in ``sd_*`` columns. A car's SPP heights scatter by metres from epoch to epoch, and a path through them
+    would pitch the antenna by tens of degrees (the "ground" attitude follows the velocity), moving C/N0 with it."""
+    p = np.asarray(rec.pos_ecef, float)
+    ok = np.isfinite(p).all(axis=1)
+    sd = track_sigma_enu(p[ok], centre)
+    lla = frames.ecef_to_lla(p[ok])
+    h = float(np.median(lla[:, 2]))
+    rows = [f"{w:d},{s:.4f},{np.degrees(la):.9f},{np.degrees(lo):.9f},{h:.3f},{sd[0]:.3f},{sd[1]:.3f},0.010"
+            for w, s, la, lo in zip(np.asarray(rec.week)[ok], np.asarray(rec.sow)[ok], lla[:, 0], lla[:, 1])]
+    return "\n".join([f"# {name}: horizontal positions, heights set to their median (simkit twin)",
+                      "gps_week,gps_sow,lat_deg,lon_deg,h_m,sd_e_m,sd_n_m,sd_u_m", *rows]) + "\n"
+
+
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
-             reference_source=None, progress: bool = False) -> dict:
+             reference_source=None, progress: bool = False, trajectory=None, trajectory_solution=None) -> dict:
     """Import ``obs_path`` (+ ``nav_paths``), simulate its twin into ``out_dir``/twin.h5 (and with ``fit`` the
-    calibrated twin_fit.h5), compare; returns the fidelity dict (also the content of fidelity.json)."""
+    calibrated twin_fit.h5), compare; returns the fidelity dict (also the content of fidelity.json).
+
+    ``trajectory``: a log of the receiver's path (any ``[trajectory] source``: e.g. the real file's own SPP
+    solution, ``real.h5`` with ``trajectory_solution="spp"``): the twin of a moving receiver. Its outlying
+    samples are dropped (``outliers = "drop"``); elevations for the statistics are taken from the log's median
+    position (a car's few hundred metres move them by less than 0.01 deg) and no horizon profile is fitted."""
     out_dir = Path(out_dir)
     if not nav_paths:
         raise InputError("--nav", "the twin needs the broadcast navigation file(s) of the observation file")
     imported = importer.import_rinex(obs_path, nav_paths, reference, reference_source)
     real = real_arrays(imported)
     ref = real["reference"]
-    if ref is None:
-        raise InputError(str(obs_path), "no reference position (no APPROX POSITION XYZ in the header): give "
-                                        "--reference X,Y,Z; a moving receiver's twin is not supported")
     out_dir.mkdir(parents=True, exist_ok=True)
+    if trajectory is not None:
+        from ..logs import read
+
+        rec = read(Path(trajectory), solution=trajectory_solution)
+        ref = np.nanmedian(rec.pos_ecef, axis=0)
+        (out_dir / "trajectory.csv").write_text(level_track_csv(rec, ref, Path(trajectory).name))
+        real["trajectory"] = {"source": str((out_dir / "trajectory.csv").resolve()), "outliers": "drop",
+                              "attitude": "ground"}
+    elif ref is None:
+        raise InputError(str(obs_path), "no reference position (no APPROX POSITION XYZ in the header): give "
+                                        "--reference X,Y,Z, or the receiver's path with --trajectory LOG (a moving "
+                                        "receiver, e.g. the file's SPP solution: docs/real_data.md)")
     importer.write(out_dir / "real.h5", imported)
     mask = inferred_mask_deg(real, ref)
     result = {"obs": Path(obs_path).name, "nav": [Path(n).name for n in nav_paths],
-              "reference": imported.report["reference"], "epochs": int(real["t"].size),
+              "reference": imported.report["reference"] if trajectory is None else
+              f"moving: the path of {Path(trajectory).name}" + (f" /solutions/{trajectory_solution}"
+                                                               if trajectory_solution else ""), "epochs": int(real["t"].size),
               "span_s": float(real["t"][-1]), "signals": real["signals"], "seed": seed}
     result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
                                                       out_dir / "twin.h5", progress, arrays=True)
