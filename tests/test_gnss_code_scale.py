@@ -52,3 +52,38 @@ def test_a_malformed_table_is_one_error_naming_the_key(table, key, words):
     with pytest.raises(ScenarioError) as e:
         load(_scenario({"L1C": table}))
     assert f"gnss.code_error_scale.{key}" in str(e.value) and words in str(e.value)
+
+
+def test_an_antenna_gain_pattern_sets_cn0_by_the_angle_from_boresight(tmp_path):
+    """A level antenna: off-boresight = 90 deg - elevation, C/N0 = zenith + signal offset + the pattern there."""
+    from simkit.gnss import signals as sigmod
+
+    pattern = {"off_boresight_deg": [0.0, 40.0, 80.0], "gain_db": [2.0, -1.0, -15.0]}
+    sc = _scenario({})
+    sc["gnss"]["antenna"] = [{"lever_arm_m": [0.0, 0.0, 0.0], "gain_pattern": pattern}]
+    sc["gnss"]["cn0_zenith_dbhz"] = 44.0
+    with open_dataset(run(sc, out=tmp_path / "p.h5")) as ds:
+        g = read_gnss(ds, antennas=0, obs=("cn0",), truth=("elevation",))
+    el = np.degrees(g.truth["elevation"])
+    for name in ("L1C", "L2W"):
+        on = np.isfinite(g.obs["cn0"][name])
+        assert on.sum() > 1000
+        expected = 44.0 + sigmod.get(name).cn0_offset_db + np.interp(90.0 - el[on], pattern["off_boresight_deg"],
+                                                                       pattern["gain_db"])
+        np.testing.assert_allclose(g.obs["cn0"][name][on], expected, atol=1e-9)
+
+
+@pytest.mark.parametrize("antenna, key, words", [
+    ({"gain_pattern": {"off_boresight_deg": [0.0, 90.0], "gain_db": [0.0]}}, "gain_pattern.gain_db",
+     "one gain per angle"),
+    ({"gain_pattern": {"off_boresight_deg": [50.0, 10.0], "gain_db": [0.0, 1.0]}},
+     "gain_pattern.off_boresight_deg", "increasing"),
+    ({"gain_pattern": {"off_boresight_deg": [0.0], "gain_db": [0.0]}, "rolloff_db": 5.0}, "gain_pattern",
+     "cannot be given with rolloff_db"),
+])
+def test_a_malformed_gain_pattern_is_one_error_naming_the_key(antenna, key, words):
+    sc = _scenario({})
+    sc["gnss"]["antenna"] = [{"lever_arm_m": [0.0, 0.0, 0.0], **antenna}]
+    with pytest.raises(ScenarioError) as e:
+        load(sc)
+    assert f"gnss.antenna[0].{key}" in str(e.value) and words in str(e.value)

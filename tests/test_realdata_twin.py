@@ -148,3 +148,26 @@ def test_the_fitted_fragment_is_a_valid_gnss_section(tmp_path):
     sc["gnss"]["signals"] = ["L1C", "L2W"]
     assert load(sc).gnss.code_error_scale == tables
     assert loaded.gnss.multipath.carrier_sigma_m == pytest.approx(0.01)
+
+
+@pytest.mark.slow
+def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
+    """Berlin (a car, GPS L1 C/A, 5 Hz, 12 s test copy): import, SPP, then the twin along the SPP path."""
+    from realdata_helpers import BERLIN_NAV, BERLIN_OBS
+
+    real = tmp_path / "real.h5"
+    assert main(["import", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "-o", str(real)]) == 0
+    assert main(["solve", str(real), "--filter", "spp", "--set", 'estimator.systems="G"']) == 0
+    out = tmp_path / "twin"
+    assert main(["twin", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "--trajectory", str(real),
+                 "--trajectory-solution", "spp", "-o", str(out), "--fit", "--no-plots"]) == 0
+    capsys.readouterr()
+    fid = json.loads((out / "fidelity.json").read_text())
+    assert fid["reference"].startswith("moving") and "horizon" in fid and fid["horizon"] is None
+    # the levelled path: one height, the SPP's horizontal positions
+    rows = [r.split(",") for r in (out / "trajectory.csv").read_text().splitlines() if r[0].isdigit()]
+    assert len({r[4] for r in rows}) == 1 and len(rows) > 50
+    # the fitted gain pattern brings the twin's C/N0 per elevation bin onto the receiver's (in sample)
+    assert fid["fitted"]["cn0_rms_difference_dbhz"]["L1C"] < 1.5 < fid["default"]["cn0_rms_difference_dbhz"]["L1C"]
+    fragment = tomllib.loads((out / "fitted.toml").read_text())
+    assert "gain_pattern" in fragment["gnss"]["antenna"][0] and "environment" not in fragment

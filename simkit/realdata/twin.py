@@ -262,15 +262,19 @@ def fit_parameters(real: dict, reference) -> dict:
 
 def _gain_pattern(real, sigs, el, p) -> tuple:
     """The antenna gain pattern (off-boresight deg, gain dB) of a level antenna (off-boresight = 90 deg -
-    elevation) at the elevation bins' centres: the mean of C/N0 minus each signal's offset over the bin, minus
-    the fitted zenith C/N0; bins without ``fidelity.by_elevation``'s minimum count take the quadratic rolloff."""
+    elevation), a step per elevation bin (two points just inside its edges): the mean of C/N0 minus each
+    signal's offset over the bin, minus the fitted zenith C/N0; a bin without ``fidelity.by_elevation``'s
+    minimum count takes the quadratic rolloff at its centre. Steps, not a line through the bins' centres: the
+    satellites of a short file sit anywhere in their bin, and the comparison is per bin."""
     edges = fidelity.ELEVATION_EDGES_DEG
-    off = 90.0 - 0.5 * (edges[:-1] + edges[1:])
     pooled = np.concatenate([real["obs"]["cn0"][g.name] - g.cn0_offset_db for g in sigs], axis=1)
     mean = fidelity.by_elevation(pooled, np.tile(el, (1, len(sigs))))
-    gain = [m - p["cn0_zenith_dbhz"] if m is not None else -p["rolloff_db"] * (o / 90.0) ** 2
-            for m, o in zip(mean, off)]
-    return tuple(float(x) for x in off[::-1]), tuple(float(x) for x in gain[::-1])
+    off, gain = [], []
+    for lo, hi, m in reversed(list(zip(edges[:-1], edges[1:], mean))):
+        g = m - p["cn0_zenith_dbhz"] if m is not None else -p["rolloff_db"] * ((90.0 - 0.5 * (lo + hi)) / 90.0) ** 2
+        off += [90.0 - hi + 0.01, 90.0 - lo - 0.01]
+        gain += [float(g), float(g)]
+    return tuple(float(x) for x in off), tuple(gain)
 
 
 def rescale(p: dict, result: dict) -> dict:
