@@ -1,14 +1,14 @@
 """``simkit twin``: simulate the receiver of a real RINEX file and measure how far the simulation is from it.
 
 The twin is a simkit scenario built from the real file: a static antenna at the reference position (header
-APPROX POSITION or the given one), the same first epoch, span and interval, the same signals, the broadcast sky of
-the same navigation files, and the elevation mask inferred from the data (the lowest elevation tracked, floored to
-a whole degree). Its [gnss] error parameters are simkit's defaults, or with ``fit`` the ones estimated from the
-real file (:func:`fit_parameters`): the calibrated twin.
+APPROX POSITION or the given one) or a moving one along a logged path (``trajectory``: e.g. the file's own SPP
+solution), the same first epoch, span and interval, the same signals, the broadcast sky of the same navigation
+files, and the elevation mask inferred from the data (the lowest elevation tracked, floored to a whole degree).
+Its [gnss] error parameters are simkit's defaults, or with ``fit`` the ones estimated from the real file
+(:func:`fit_parameters`, :func:`fit_horizon`, :func:`code_tables`, :mod:`.ionosphere`): the calibrated twin,
+checked in sample and out of sample (fitted on the first half of the epochs, compared on the second).
 
 Both files go through the same statistics (:mod:`.fidelity`); the comparison is returned as a JSON-ready dict.
-A moving receiver (no reference position) is not twinned here: its trajectory would have to come from a
-solution of the real file.
 """
 from __future__ import annotations
 
