@@ -18,12 +18,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import frames, gpstime
+from ..constellation.geometry import angles_from_enu, lines_of_sight_enu
 from ..earth import C_LIGHT
 from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
 from ..gnss.config import code_scale_at
-from ..constellation.geometry import angles_from_enu, lines_of_sight_enu
 from . import fidelity, horizon, importer, ionosphere
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
