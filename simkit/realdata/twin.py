@@ -199,7 +199,8 @@ def fit_parameters(real: dict, reference) -> dict:
     """simkit [gnss] error parameters estimated from the real file (the calibrated twin's).
 
     * C/N0: least squares of C/N0 = cn0_zenith + signal offset - rolloff ((90 - el) / 90)^2 (the simulator's
-      model, :mod:`simkit.gnss.noise`) over every observation with a signal strength; defaults when none.
+      model, :mod:`simkit.gnss.noise`) over every observation with a signal strength, then the gain pattern per
+      elevation bin (:func:`_gain_pattern`); defaults when none.
     * Code: the code-minus-carrier scatter per signal and elevation bin against the simulator's code error
       f_s sqrt(DLL jitter(C/N0(el))^2 + (sigma_h exp(-el / el0))^2): one multipath profile (sigma_h, el0) and a
       per-signal factor f_s (``[gnss.code_error_scale]``: a receiver's correlators and multipath mitigation differ
@@ -214,22 +215,8 @@ def fit_parameters(real: dict, reference) -> dict:
     st = statistics(real, el)
     p = dict(DEFAULTS)
     notes = []
-    signals = real["signals"]
-    sigs = [sigmod.get(s) for s in signals]
-    rows_x, rows_y = [], []
-    for g in sigs:
-        c = real["obs"]["cn0"][g.name]
-        ok = np.isfinite(c) & np.isfinite(el)
-        if ok.any():
-            x = ((np.pi / 2 - el[ok]) / (np.pi / 2)) ** 2
-            rows_x.append(np.column_stack([np.ones(x.size), -x]))
-            rows_y.append(c[ok] - g.cn0_offset_db)
-    if rows_x:
-        sol = np.linalg.lstsq(np.vstack(rows_x), np.concatenate(rows_y), rcond=None)[0]
-        p["cn0_zenith_dbhz"] = float(np.clip(sol[0], 10.0, 70.0))
-        p["rolloff_db"] = float(max(sol[1], 0.0))
-        p["gain_pattern"] = _gain_pattern(real, sigs, el, p)
-    else:
+    sigs = [sigmod.get(s) for s in real["signals"]]
+    if not _fit_cn0(real, sigs, el, p):
         notes.append("no signal-strength observations: C/N0 model left at the defaults")
     edges = fidelity.ELEVATION_EDGES_DEG
     centres = np.radians(0.5 * (edges[:-1] + edges[1:]))
@@ -258,6 +245,26 @@ def fit_parameters(real: dict, reference) -> dict:
                      "ionosphere's residual left at the default")
     p["_notes"] = notes
     return p
+
+
+def _fit_cn0(real, sigs, el, p) -> bool:
+    """Set ``p``'s zenith C/N0, rolloff and gain pattern from the real C/N0 (least squares of the quadratic
+    model, then :func:`_gain_pattern`); False when the file has no signal strength."""
+    rows_x, rows_y = [], []
+    for g in sigs:
+        c = real["obs"]["cn0"][g.name]
+        ok = np.isfinite(c) & np.isfinite(el)
+        if ok.any():
+            x = ((np.pi / 2 - el[ok]) / (np.pi / 2)) ** 2
+            rows_x.append(np.column_stack([np.ones(x.size), -x]))
+            rows_y.append(c[ok] - g.cn0_offset_db)
+    if not rows_x:
+        return False
+    sol = np.linalg.lstsq(np.vstack(rows_x), np.concatenate(rows_y), rcond=None)[0]
+    p["cn0_zenith_dbhz"] = float(np.clip(sol[0], 10.0, 70.0))
+    p["rolloff_db"] = float(max(sol[1], 0.0))
+    p["gain_pattern"] = _gain_pattern(real, sigs, el, p)
+    return True
 
 
 def _gain_pattern(real, sigs, el, p) -> tuple:
