@@ -19,6 +19,9 @@ def add_parser(sub):
     p.add_argument("-o", "--out", default="twin", help="output folder (created; default ./twin)")
     p.add_argument("--fit", action="store_true", help="fit the [gnss] error parameters and run the calibrated twin")
     p.add_argument("--reference", metavar="X,Y,Z", help="receiver position, m ECEF (default: the header's)")
+    p.add_argument("--trajectory", metavar="LOG", help="a moving receiver: its path from a log (any [trajectory] "
+                   "source: CSV, NMEA, GPX, KML, or a simkit file's /solutions, e.g. the real file's SPP)")
+    p.add_argument("--trajectory-solution", metavar="NAME", help="the /solutions group of an .h5 --trajectory")
     p.add_argument("--seed", type=int, default=1, help="seed of the twin (default 1)")
     p.add_argument("--no-plots", action="store_true", help="no figures (they need the 'plot' extra)")
     return p
@@ -29,17 +32,19 @@ def run(args) -> int:
     from ..io.output import check_output
     from ..realdata import importer, twin
 
-    for path in [args.obs, *args.nav]:
+    for path in [args.obs, *args.nav, *([args.trajectory] if args.trajectory else [])]:
         if not Path(path).is_file():
             raise OutputError(path, "no such file")
-    out = check_output(args.out, [args.obs, *args.nav], option="-o", folder=True, parents=True)
+    out = check_output(args.out, [args.obs, *args.nav, *([args.trajectory] if args.trajectory else [])], option="-o",
+                       folder=True, parents=True)
     if not args.no_plots:
         from ..plots import require_matplotlib
 
         require_matplotlib("twin (or --no-plots)")
     reference, source = importer.parse_reference(args.reference, None)
     fid = twin.run_twin(args.obs, args.nav, out, fit=args.fit, seed=args.seed, reference=reference,
-                        reference_source=source)
+                        reference_source=source, trajectory=args.trajectory,
+                        trajectory_solution=args.trajectory_solution)
     figures = []
     if not args.no_plots:
         from ..plots import twin_figures

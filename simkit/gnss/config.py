@@ -24,6 +24,7 @@ class Antenna:
     boresight_b: np.ndarray      # (3,) unit vector, body frame
     horizon_mask_rad: float      # satellites less than this above the antenna's horizon plane are masked
     rolloff_db: float            # gain at the antenna horizon relative to boresight (dB, >= 0)
+    gain_pattern: tuple | None = None   # ((off-boresight deg, ...), (gain dB, ...)): replaces the rolloff
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,7 @@ class GnssConfig:
     outages: tuple[Outage, ...]
     ambiguity_max_cycles: int
     iono_coefficients: dict[str, tuple] = field(default_factory=dict)  # "gps"/"bds" -> (alpha, beta) overrides
-    code_error_scale: dict[str, float] = field(default_factory=dict)  # signal -> factor on code noise + multipath
+    code_error_scale: dict = field(default_factory=dict)  # signal -> factor (or (el_deg, factor) table) on code noise + multipath
     truth_errors: TruthErrorsConfig | None = None  # departures of the truth from the receiver's models; None: off
 
     @property
@@ -155,11 +156,29 @@ def _signals(sec: Section) -> list[str]:
 
 
 def _antenna(a: Section) -> Antenna:
+    pattern = None
+    if a.has("gain_pattern"):
+        if a.has("rolloff_db"):
+            raise a.error("gain_pattern", "cannot be given with rolloff_db: the pattern replaces the rolloff")
+        pattern = _gain_pattern(a.section("gain_pattern"))
     return Antenna(
         lever_arm_b=np.asarray(a.get("lever_arm_m", float, shape=3)),
         boresight_b=_unit(a.get("boresight_b", float, [0.0, 0.0, 1.0], shape=3), a, "boresight_b"),
         horizon_mask_rad=np.radians(a.get("horizon_mask_deg", float, 0.0, check=in_range(-90.0, 90.0))),
-        rolloff_db=a.get("rolloff_db", float, 10.0, check=non_negative))
+        rolloff_db=a.get("rolloff_db", float, 10.0, check=non_negative), gain_pattern=pattern)
+
+
+def _gain_pattern(t: Section) -> tuple:
+    """``gain_pattern = {off_boresight_deg = [...], gain_db = [...]}``: the antenna gain relative to the zenith
+    C/N0 at increasing angles from the boresight in [0, 180] (linear in between, the end values beyond)."""
+    off = t.get("off_boresight_deg", float, shape=0)
+    gain = t.get("gain_db", float, shape=0)
+    if not off or len(off) != len(gain):
+        raise t.error("gain_db", f"expected one gain per angle ({len(off)}), got {len(gain)}")
+    if any(b <= a for a, b in zip(off, off[1:])) or not all(0.0 <= x <= 180.0 for x in off):
+        raise t.error("off_boresight_deg", f"expected increasing angles in [0, 180], got {off!r}")
+    t.done()
+    return tuple(off), tuple(gain)
 
 
 def _noise(nz: Section) -> NoiseConfig:
@@ -210,14 +229,40 @@ def _outage(o: Section, n_antennas: int) -> Outage:
 
 def _code_scale(cs: Section, sigs: list[str]) -> dict:
     """[gnss.code_error_scale]: signal name -> factor (>= 0) on that signal's code noise and code multipath (a
-    receiver's code tracking: correlator spacing, multipath mitigation; ``simkit twin --fit`` estimates them)."""
+    receiver's code tracking: correlator spacing, multipath mitigation; ``simkit twin --fit`` estimates them):
+    a number, or a table ``{elevation_deg = [...], factor = [...]}`` (increasing elevations in [-90, 90],
+    linear in between, the end values beyond), kept as the pair of tuples (elevation_deg, factor)."""
     out = {}
     for name in sigs:
+        if isinstance(cs.data.get(name), dict):
+            out[name] = _code_scale_table(cs.section(name))
+            continue
         value = cs.get(name, float, None, check=non_negative)
         if value is not None:
             out[name] = value
     cs.done()
     return out
+
+
+def _code_scale_table(t: Section) -> tuple:
+    el = t.get("elevation_deg", float, shape=0)
+    factor = t.get("factor", float, shape=0)
+    if not el or len(el) != len(factor):
+        raise t.error("factor", f"expected one factor per elevation ({len(el)}), got {len(factor)}")
+    if any(b <= a for a, b in zip(el, el[1:])) or not all(-90.0 <= e <= 90.0 for e in el):
+        raise t.error("elevation_deg", f"expected increasing elevations in [-90, 90], got {el!r}")
+    if any(f < 0 for f in factor):
+        raise t.error("factor", f"must be >= 0, got {factor!r}")
+    t.done()
+    return tuple(el), tuple(factor)
+
+
+def code_scale_at(scale, el_rad):
+    """The factor of a ``code_error_scale`` entry (a number or an (elevation_deg, factor) pair) at elevations
+    ``el_rad`` (rad, any shape)."""
+    if not isinstance(scale, tuple):
+        return scale
+    return np.interp(np.degrees(el_rad), scale[0], scale[1])
 
 
 def _ionosphere(io: Section) -> dict:

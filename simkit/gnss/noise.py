@@ -21,6 +21,12 @@ def cn0_dbhz(off_boresight_rad, cn0_zenith_dbhz, rolloff_db, offset_db):
     return cn0_zenith_dbhz + offset_db - rolloff_db * (off_boresight_rad / (np.pi / 2.0)) ** 2
 
 
+def pattern_cn0_dbhz(off_boresight_rad, cn0_zenith_dbhz, pattern, offset_db):
+    """C/N0 (dB-Hz) with a tabulated gain ``pattern`` ((off-boresight deg, ...), (gain dB, ...)) instead of the
+    quadratic rolloff; linear in the angle, the end values beyond the table."""
+    return cn0_zenith_dbhz + offset_db + np.interp(np.degrees(off_boresight_rad), pattern[0], pattern[1])
+
+
 def dll_sigma_m(cn0_db, chip_length_m, b_dll_hz, spacing_chips, t_int_s):
     """Code (DLL) thermal-noise standard deviation (m)."""
     c = 10.0 ** (np.asarray(cn0_db) / 10.0)

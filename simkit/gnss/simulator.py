@@ -31,7 +31,7 @@ from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
 from ..errors import DataFileError, ScenarioError
 from . import atmosphere, noise, signals as sigmod, tworay
 from .clock import ClockProcess
-from .config import GnssConfig, check_sats
+from .config import GnssConfig, check_sats, code_scale_at
 from .draws import KeyedNormals
 from .ephemeris_errors import EphemerisErrors, rac_axes
 from .ionex import read_ionex
@@ -391,14 +391,18 @@ class _Parts:
         cols = self.cand[cj]
         rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
         cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, g.cn0_offset_db)
+        for a, ant in enumerate(cfg.antennas):
+            if ant.gain_pattern is not None:
+                cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern,
+                                                   g.cn0_offset_db)
         freq = sim.freq[cols, j]                                                    # (C,) Hz
         lam = C_LIGHT / freq if g.is_fdma else g.wavelength_m
         sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g, lam))
-        code_scale = cfg.code_error_scale.get(g.name, 1.0)
-        sig_c = sig_c * code_scale
         scale = (atmosphere.reference_frequency(g.system) / freq) ** 2
         iono, iono_rate = self.iono[..., cj] * scale, self.iono_rate[..., cj] * scale
         el = self.el[..., cj]
+        code_scale = code_scale_at(cfg.code_error_scale.get(g.name, 1.0), el)
+        sig_c = sig_c * code_scale
         if self.mp is not None:
             mp_c = elevation_scale(el, cfg.multipath.code_sigma_m * code_scale, cfg.multipath.elevation_scale_rad) * \
                 self.mp[:, :, cj, j, 0]

@@ -1,14 +1,14 @@
 """``simkit twin``: simulate the receiver of a real RINEX file and measure how far the simulation is from it.
 
 The twin is a simkit scenario built from the real file: a static antenna at the reference position (header
-APPROX POSITION or the given one), the same first epoch, span and interval, the same signals, the broadcast sky of
-the same navigation files, and the elevation mask inferred from the data (the lowest elevation tracked, floored to
-a whole degree). Its [gnss] error parameters are simkit's defaults, or with ``fit`` the ones estimated from the
-real file (:func:`fit_parameters`): the calibrated twin.
+APPROX POSITION or the given one) or a moving one along a logged path (``trajectory``: e.g. the file's own SPP
+solution), the same first epoch, span and interval, the same signals, the broadcast sky of the same navigation
+files, and the elevation mask inferred from the data (the lowest elevation tracked, floored to a whole degree).
+Its [gnss] error parameters are simkit's defaults, or with ``fit`` the ones estimated from the real file
+(:func:`fit_parameters`, :func:`fit_horizon`, :func:`code_tables`, :mod:`.ionosphere`): the calibrated twin,
+checked in sample and out of sample (fitted on the first half of the epochs, compared on the second).
 
 Both files go through the same statistics (:mod:`.fidelity`); the comparison is returned as a JSON-ready dict.
-A moving receiver (no reference position) is not twinned here: its trajectory would have to come from a
-solution of the real file.
 """
 from __future__ import annotations
 
@@ -18,11 +18,13 @@ from pathlib import Path
 import numpy as np
 
 from .. import frames, gpstime
+from ..constellation.geometry import angles_from_enu, lines_of_sight_enu
 from ..earth import C_LIGHT
 from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
-from . import fidelity, importer
+from ..gnss.config import code_scale_at
+from . import fidelity, horizon, importer, ionosphere
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -41,7 +43,10 @@ def real_arrays(imported: importer.Imported) -> dict:
             "freq": d["gnss/frequency_hz"], "sat_pos": d["gnss/sat_pos_ecef"],
             "obs": {k: {s: d[f"gnss/obs/{s}/{k}"][:, 0] for s in signals} for k in KINDS},
             "reference": d.get("reference/pos_ecef"), "start": (int(imported.attrs["start_gps_week"]),
-                                                                 float(imported.attrs["start_gps_sow"]))}
+                                                                 float(imported.attrs["start_gps_sow"])),
+            "group_delay": d.get("gnss/group_delay"),
+            "iono": {str(k): (a, b) for k, a, b in zip(d.get("gnss/iono_systems", []), d.get("gnss/iono_alpha", []),
+                                                          d.get("gnss/iono_beta", []))}}
 
 
 def file_arrays(path) -> dict:
@@ -69,27 +74,40 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
     week, sow = real["start"]
     t = real["t"]
     interval = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    duration = float(np.floor(t[-1] / interval + 1e-6) * interval)   # on the twin's epoch grid
     start = gpstime.gps_to_utc(week, sow)
     lla = frames.ecef_to_lla(np.asarray(reference, float)[None])[0]
     p = {**DEFAULTS, **params}
+    if real.get("trajectory"):           # a moving receiver: the path of a log ([trajectory] source)
+        trajectory = {"rate_hz": 1.0 / interval, **real["trajectory"]}
+    else:
+        trajectory = {"rate_hz": 1.0 / interval,
+                      "origin": {"lat_deg": float(np.degrees(lla[0])), "lon_deg": float(np.degrees(lla[1])),
+                                 "height_m": float(lla[2])},
+                      "initial": {"speed_m_per_s": 0.0, "heading_deg": 0.0},
+                      "segment": [{"kind": "static", "duration_s": duration}]}
     return {
         "scenario": {"name": "twin", "start": start.isoformat(timespec="microseconds").replace("+00:00", "Z"),
-                     "duration_s": float(t[-1]), "seed": int(seed)},
-        "trajectory": {"rate_hz": 1.0 / interval,
-                       "origin": {"lat_deg": float(np.degrees(lla[0])), "lon_deg": float(np.degrees(lla[1])),
-                                  "height_m": float(lla[2])},
-                       "initial": {"speed_m_per_s": 0.0, "heading_deg": 0.0},
-                       "segment": [{"kind": "static", "duration_s": float(t[-1])}]},
+                     "duration_s": duration, "seed": int(seed)},
+        "trajectory": trajectory,
         "gnss": {"rate_hz": 1.0 / interval, "elevation_mask_deg": mask_deg, "signals": list(real["signals"]),
                  "cn0_zenith_dbhz": p["cn0_zenith_dbhz"], "slip_rate_per_h": p["slip_rate_per_h"],
                  "constellation": [{"source": str(Path(n).resolve())} for n in nav_paths],
-                 "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0], "rolloff_db": p["rolloff_db"]}],
+                 "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0],
+                              **({"gain_pattern": {"off_boresight_deg": list(p["gain_pattern"][0]),
+                                                   "gain_db": list(p["gain_pattern"][1])}}
+                                 if p.get("gain_pattern") else {"rolloff_db": p["rolloff_db"]})}],
                  "noise": {"dll_bandwidth_hz": p["dll_bandwidth_hz"], "pll_bandwidth_hz": p["pll_bandwidth_hz"],
                            "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
-                 "code_error_scale": dict(p.get("code_error_scale", {})),
+                 "code_error_scale": {k: {"elevation_deg": list(v[0]), "factor": list(v[1])}
+                                      if isinstance(v, tuple) else v for k, v in p.get("code_error_scale", {}).items()},
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
-                               "correlation_time_s": p["mp_correlation_time_s"]}},
+                               "correlation_time_s": p["mp_correlation_time_s"]},
+                 **({"truth_errors": {"iono_residual_fraction": p["iono_residual_fraction"]}}
+                    if p.get("iono_residual_fraction") is not None else {})},
+        **({"environment": {"reflections": False, "body_mask": [dict(p["horizon_mask"])]}}
+           if p.get("horizon_mask") else {}),
     }
 
 
@@ -181,7 +199,8 @@ def fit_parameters(real: dict, reference) -> dict:
     """simkit [gnss] error parameters estimated from the real file (the calibrated twin's).
 
     * C/N0: least squares of C/N0 = cn0_zenith + signal offset - rolloff ((90 - el) / 90)^2 (the simulator's
-      model, :mod:`simkit.gnss.noise`) over every observation with a signal strength; defaults when none.
+      model, :mod:`simkit.gnss.noise`) over every observation with a signal strength, then the gain pattern per
+      elevation bin (:func:`_gain_pattern`); defaults when none.
     * Code: the code-minus-carrier scatter per signal and elevation bin against the simulator's code error
       f_s sqrt(DLL jitter(C/N0(el))^2 + (sigma_h exp(-el / el0))^2): one multipath profile (sigma_h, el0) and a
       per-signal factor f_s (``[gnss.code_error_scale]``: a receiver's correlators and multipath mitigation differ
@@ -196,21 +215,8 @@ def fit_parameters(real: dict, reference) -> dict:
     st = statistics(real, el)
     p = dict(DEFAULTS)
     notes = []
-    signals = real["signals"]
-    sigs = [sigmod.get(s) for s in signals]
-    rows_x, rows_y = [], []
-    for g in sigs:
-        c = real["obs"]["cn0"][g.name]
-        ok = np.isfinite(c) & np.isfinite(el)
-        if ok.any():
-            x = ((np.pi / 2 - el[ok]) / (np.pi / 2)) ** 2
-            rows_x.append(np.column_stack([np.ones(x.size), -x]))
-            rows_y.append(c[ok] - g.cn0_offset_db)
-    if rows_x:
-        sol = np.linalg.lstsq(np.vstack(rows_x), np.concatenate(rows_y), rcond=None)[0]
-        p["cn0_zenith_dbhz"] = float(np.clip(sol[0], 10.0, 70.0))
-        p["rolloff_db"] = float(max(sol[1], 0.0))
-    else:
+    sigs = [sigmod.get(s) for s in real["signals"]]
+    if not _fit_cn0(real, sigs, el, p):
         notes.append("no signal-strength observations: C/N0 model left at the defaults")
     edges = fidelity.ELEVATION_EDGES_DEG
     centres = np.radians(0.5 * (edges[:-1] + edges[1:]))
@@ -230,8 +236,52 @@ def fit_parameters(real: dict, reference) -> dict:
         p["mp_correlation_time_s"] = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0))
     rates = [v for v in st["slips_per_hour"].values() if v is not None]
     p["slip_rate_per_h"] = float(np.mean(rates)) if rates else 0.0
+    if real.get("group_delay") is not None and real.get("iono"):
+        iono = ionosphere.klobuchar_ratio(real, reference, real["group_delay"], real["iono"])
+        p["_ionosphere"] = iono
+        p["iono_residual_fraction"] = ionosphere.residual_fraction(iono)
+    if p.get("iono_residual_fraction") is None:
+        notes.append("no dual-frequency GPS or BDS code and carrier with a Klobuchar model: the truth "
+                     "ionosphere's residual left at the default")
     p["_notes"] = notes
     return p
+
+
+def _fit_cn0(real, sigs, el, p) -> bool:
+    """Set ``p``'s zenith C/N0, rolloff and gain pattern from the real C/N0 (least squares of the quadratic
+    model, then :func:`_gain_pattern`); False when the file has no signal strength."""
+    rows_x, rows_y = [], []
+    for g in sigs:
+        c = real["obs"]["cn0"][g.name]
+        ok = np.isfinite(c) & np.isfinite(el)
+        if ok.any():
+            x = ((np.pi / 2 - el[ok]) / (np.pi / 2)) ** 2
+            rows_x.append(np.column_stack([np.ones(x.size), -x]))
+            rows_y.append(c[ok] - g.cn0_offset_db)
+    if not rows_x:
+        return False
+    sol = np.linalg.lstsq(np.vstack(rows_x), np.concatenate(rows_y), rcond=None)[0]
+    p["cn0_zenith_dbhz"] = float(np.clip(sol[0], 10.0, 70.0))
+    p["rolloff_db"] = float(max(sol[1], 0.0))
+    p["gain_pattern"] = _gain_pattern(real, sigs, el, p)
+    return True
+
+
+def _gain_pattern(real, sigs, el, p) -> tuple:
+    """The antenna gain pattern (off-boresight deg, gain dB) of a level antenna (off-boresight = 90 deg -
+    elevation), a step per elevation bin (two points just inside its edges): the mean of C/N0 minus each
+    signal's offset over the bin, minus the fitted zenith C/N0; a bin without ``fidelity.by_elevation``'s
+    minimum count takes the quadratic rolloff at its centre. Steps, not a line through the bins' centres: the
+    satellites of a short file sit anywhere in their bin, and the comparison is per bin."""
+    edges = fidelity.ELEVATION_EDGES_DEG
+    pooled = np.concatenate([real["obs"]["cn0"][g.name] - g.cn0_offset_db for g in sigs], axis=1)
+    mean = fidelity.by_elevation(pooled, np.tile(el, (1, len(sigs))))
+    off, gain = [], []
+    for lo, hi, m in reversed(list(zip(edges[:-1], edges[1:], mean))):
+        g = m - p["cn0_zenith_dbhz"] if m is not None else -p["rolloff_db"] * ((90.0 - 0.5 * (lo + hi)) / 90.0) ** 2
+        off += [90.0 - hi + 0.01, 90.0 - lo - 0.01]
+        gain += [float(g), float(g)]
+    return tuple(float(x) for x in off), tuple(gain)
 
 
 def rescale(p: dict, result: dict) -> dict:
@@ -252,8 +302,28 @@ def rescale(p: dict, result: dict) -> dict:
     scales = dict(p.get("code_error_scale", {}))
     for s, ratios in result["code_noise_ratio"].items():
         ok = [x for x in ratios if x]
-        if ok:
+        if ok and not isinstance(scales.get(s), tuple):
             scales[s] = float(scales.get(s, 1.0) / np.median(ok))
+    p["code_error_scale"] = scales
+    return p
+
+
+def code_tables(p: dict, result: dict) -> dict:
+    """``p`` with each signal's code factor turned into a table over the elevation bins' centres: the factor
+    there divided by the twin / real code-noise ratio of that bin in the twin run ``result`` (made with ``p``);
+    a bin without a ratio takes the signal's median ratio. Code noise and code multipath are both linear in the
+    factor, so one step moves every bin onto the real sigma up to the two files' sampling scatter."""
+    p = dict(p)
+    edges = np.asarray(result["elevation_bins_deg"], float)
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    scales = dict(p.get("code_error_scale", {}))
+    for s, ratios in result["code_noise_ratio"].items():
+        ok = [x for x in ratios if x]
+        if not ok:
+            continue
+        now = np.broadcast_to(code_scale_at(scales.get(s, 1.0), np.radians(centres)), centres.shape)
+        r = np.array([x if x else np.median(ok) for x in ratios])
+        scales[s] = (tuple(float(c) for c in centres), tuple(float(f) for f in now / r))
     p["code_error_scale"] = scales
     return p
 
@@ -308,49 +378,186 @@ def toml_fragment(p: dict) -> str:
              f"carrier_sigma_m = {p['mp_carrier_sigma_m']:.5f}",
              f"elevation_scale_deg = {p['mp_elevation_scale_deg']:.2f}",
              f"correlation_time_s = {p['mp_correlation_time_s']:.1f}", "",
-             "[gnss.code_error_scale]", *(f"{k} = {v:.4f}" for k, v in p.get("code_error_scale", {}).items()), "",
-             "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]", f"rolloff_db = {p['rolloff_db']:.2f}"]
+             "[gnss.code_error_scale]", *(f"{k} = {_scale_toml(v)}" for k, v in p.get("code_error_scale", {}).items()),
+             "",
+             "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]",
+             f"rolloff_db = {p['rolloff_db']:.2f}" if not p.get("gain_pattern") else
+             f"gain_pattern = {{off_boresight_deg = [{', '.join(f'{x:g}' for x in p['gain_pattern'][0])}], "
+             f"gain_db = [{', '.join(f'{x:.2f}' for x in p['gain_pattern'][1])}]}}"]
+    if p.get("iono_residual_fraction") is not None:
+        lines += ["", "# the real ionosphere against Klobuchar (dual-frequency geometry-free, carrier-levelled code)",
+                  "[gnss.truth_errors]", f"iono_residual_fraction = {p['iono_residual_fraction']:.4f}"]
+    if p.get("horizon_mask"):
+        tab = p["horizon_mask"]
+        lines += ["", "# the station's horizon profile (a level antenna facing north: body azimuth = azimuth)",
+                  "[environment]", "reflections = false", "", "[[environment.body_mask]]",
+                  f"azimuth_deg = [{', '.join(f'{a:g}' for a in tab['azimuth_deg'])}]",
+                  f"elevation_deg = [{', '.join(f'{e:g}' for e in tab['elevation_deg'])}]"]
     return "\n".join(lines) + "\n"
 
 
-def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress):
+def _scale_toml(v) -> str:
+    if isinstance(v, tuple):
+        return (f"{{elevation_deg = [{', '.join(f'{e:g}' for e in v[0])}], "
+                f"factor = [{', '.join(f'{f:.4f}' for f in v[1])}]}}")
+    return f"{v:.4f}"
+
+
+def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress, arrays=False):
     from ..pipeline import run
 
     run(scenario(real, ref, nav_paths, mask, params, seed), out=path, progress=progress, force=True)
     twin = file_arrays(path)
-    return compare(on_twin_grid(real, twin), twin, ref, mask)
+    on_grid = on_twin_grid(real, twin)
+    result = compare(on_grid, twin, ref, mask)
+    return (result, on_grid, twin) if arrays else result
+
+
+def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> dict:
+    """The horizon profile (:mod:`.horizon`) from the real tracking on the twin's grid and the twin's geometry
+    (``twin`` simulated without a profile): the ``[[environment.body_mask]]`` table, its in-sample agreement and
+    the agreement fitted on one half of the epochs and checked on the other."""
+    rx = np.broadcast_to(np.asarray(reference, float), (twin["t"].size, 3))
+    with np.errstate(invalid="ignore"):
+        el, az = angles_from_enu(lines_of_sight_enu(rx, twin["sat_pos"])[0])
+    real_on, twin_on = fidelity.tracked(real_on_grid["obs"]), fidelity.tracked(twin["obs"])
+    floor = np.radians(mask_deg)
+    table = horizon.mask_table(horizon.profile(el, az, real_on, floor, simulated=twin_on))
+    return {"table": table, "sector_deg": horizon.SECTOR_DEG,
+            "in_sample": horizon.agreement(el, az, real_on, twin_on, floor, table),
+            "holdout": horizon.holdout(el, az, real_on, twin_on, floor)}
+
+
+def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
+    """The fitted parameters of ``real`` (:func:`fit_parameters`, the horizon profile, then the carrier, Doppler
+    and code terms scaled from a default and a first calibrated twin, and the code factors made tables over
+    elevation), the fit's notes and {"horizon": :func:`fit_horizon`, "ionosphere": the Klobuchar comparison of
+    :func:`.ionosphere.klobuchar_ratio`}; ``default`` = (comparison, real on the grid, twin arrays)
+    of a default twin already run on ``real``."""
+    if default is None:
+        default = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed, path, progress, arrays=True)
+    fitted = fit_parameters(real, ref)
+    notes = fitted.pop("_notes")
+    iono = fitted.pop("_ionosphere", None)
+    hz = None
+    if not real.get("trajectory"):       # a horizon profile belongs to a fixed antenna
+        hz = fit_horizon(default[1], default[2], ref, mask)
+        fitted["horizon_mask"] = hz["table"]
+    fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
+    first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
+    tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
+    fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
+    return fitted, notes, {"horizon": hz, "ionosphere": iono}
+
+
+def _rows(arr: dict, rows) -> dict:
+    """``arr`` (a twin or real dict) cut to the epochs ``rows`` (bool (M,))."""
+    return {**arr, "t": arr["t"][rows], "sat_pos": arr["sat_pos"][rows],
+            "obs": {k: {s: v[rows] for s, v in d.items()} for k, d in arr["obs"].items()}}
+
+
+def _holdout(real, ref, nav_paths, mask, seed, path, progress) -> dict:
+    """Out-of-sample check of the fit: every parameter (horizon profile and code tables included) fitted on the
+    first half of the epochs only, a twin of the whole span run with them, and the comparison on the second half
+    (neither the fit nor its twins saw it)."""
+    first_half = real["t"] < real["t"][0] + 0.5 * (real["t"][-1] - real["t"][0])
+    fitted, _, extras = _calibrate(_rows(real, first_half), ref, nav_paths, mask, seed + 10, path, progress)
+    from ..pipeline import run
+
+    run(scenario(real, ref, nav_paths, mask, fitted, seed + 12), out=path, progress=progress, force=True)
+    twin = file_arrays(path)
+    grid = on_twin_grid(real, twin)
+    second = twin["t"] >= real["t"][~first_half][0] - 1e-6
+    out = compare(_rows(grid, second), _rows(twin, second), ref, mask)
+    return {"fitted_on_s": [float(real["t"][first_half][0]), float(real["t"][first_half][-1])],
+            "checked_on_s": [float(twin["t"][second][0]), float(twin["t"][second][-1])],
+            "visibility_agreement": out["visibility_agreement"],
+            "satellite_epochs_above_mask": out["satellite_epochs_above_mask"],
+            "tracked_real_not_twin": out["tracked_real_not_twin"], "tracked_twin_not_real": out["tracked_twin_not_real"],
+            "code_noise_ratio": out["code_noise_ratio"], "real_code_noise_m": out["real"]["code_noise_m"],
+            "cn0_rms_difference_dbhz": out["cn0_rms_difference_dbhz"],
+            "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": (extras["horizon"] or {}).get("table"),
+            "iono_residual_fraction": fitted.get("iono_residual_fraction")}
+
+
+def track_sigma_enu(pos_ecef, centre, window: int = 51) -> list:
+    """Position noise [east, north, up] (m) of a logged track: the robust standard deviation (1.4826 MAD) of its
+    samples about their running median over ``window`` samples (10 s of a 5 Hz log). A receiver's own SPP
+    errors are correlated over seconds, so the third differences the log fit estimates its noise from see only
+    a fraction of them, and the fitted path (and the attitude that follows its velocity) would keep them."""
+    from scipy.ndimage import median_filter
+
+    p = np.asarray(pos_ecef, float)
+    p = p[np.isfinite(p).all(axis=1)]
+    lla = frames.ecef_to_lla(np.asarray(centre, float)[None])[0]
+    enu = (p - centre) @ frames.ecef_to_enu_matrix(lla[0], lla[1]).T
+    r = enu - median_filter(enu, size=(min(window, len(enu)), 1), mode="nearest")
+    return [float(max(x, 0.01)) for x in 1.4826 * np.median(np.abs(r - np.median(r, axis=0)), axis=0)]
+
+
+def level_track_csv(rec, centre, name: str) -> str:
+    """The log ``rec`` (a :class:`simkit.logs.Record`) as the CSV log of a vehicle on level ground: its epochs
+    and horizontal positions, every height the median height, and the position noise of :func:`track_sigma_enu`
+    in ``sd_*`` columns. A car's SPP heights scatter by metres from epoch to epoch, and a path through them
+    would pitch the antenna by tens of degrees (the "ground" attitude follows the velocity), moving C/N0 with it."""
+    p = np.asarray(rec.pos_ecef, float)
+    ok = np.isfinite(p).all(axis=1)
+    sd = track_sigma_enu(p[ok], centre)
+    lla = frames.ecef_to_lla(p[ok])
+    h = float(np.median(lla[:, 2]))
+    rows = [f"{w:d},{s:.4f},{np.degrees(la):.9f},{np.degrees(lo):.9f},{h:.3f},{sd[0]:.3f},{sd[1]:.3f},0.010"
+            for w, s, la, lo in zip(np.asarray(rec.week)[ok], np.asarray(rec.sow)[ok], lla[:, 0], lla[:, 1])]
+    return "\n".join([f"# {name}: horizontal positions, heights set to their median (simkit twin)",
+                      "gps_week,gps_sow,lat_deg,lon_deg,h_m,sd_e_m,sd_n_m,sd_u_m", *rows]) + "\n"
 
 
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
-             reference_source=None, progress: bool = False) -> dict:
+             reference_source=None, progress: bool = False, trajectory=None, trajectory_solution=None) -> dict:
     """Import ``obs_path`` (+ ``nav_paths``), simulate its twin into ``out_dir``/twin.h5 (and with ``fit`` the
-    calibrated twin_fit.h5), compare; returns the fidelity dict (also the content of fidelity.json)."""
+    calibrated twin_fit.h5), compare; returns the fidelity dict (also the content of fidelity.json).
+
+    ``trajectory``: a log of the receiver's path (any ``[trajectory] source``: e.g. the real file's own SPP
+    solution, ``real.h5`` with ``trajectory_solution="spp"``): the twin of a moving receiver. Its outlying
+    samples are dropped (``outliers = "drop"``); elevations for the statistics are taken from the log's median
+    position (a car's few hundred metres move them by less than 0.01 deg) and no horizon profile is fitted."""
     out_dir = Path(out_dir)
     if not nav_paths:
         raise InputError("--nav", "the twin needs the broadcast navigation file(s) of the observation file")
     imported = importer.import_rinex(obs_path, nav_paths, reference, reference_source)
     real = real_arrays(imported)
     ref = real["reference"]
-    if ref is None:
-        raise InputError(str(obs_path), "no reference position (no APPROX POSITION XYZ in the header): give "
-                                        "--reference X,Y,Z; a moving receiver's twin is not supported")
     out_dir.mkdir(parents=True, exist_ok=True)
+    if trajectory is not None:
+        from ..logs import read
+
+        rec = read(Path(trajectory), solution=trajectory_solution)
+        ref = np.nanmedian(rec.pos_ecef, axis=0)
+        (out_dir / "trajectory.csv").write_text(level_track_csv(rec, ref, Path(trajectory).name))
+        real["trajectory"] = {"source": str((out_dir / "trajectory.csv").resolve()), "outliers": "drop",
+                              "attitude": "ground"}
+    elif ref is None:
+        raise InputError(str(obs_path), "no reference position (no APPROX POSITION XYZ in the header): give "
+                                        "--reference X,Y,Z, or the receiver's path with --trajectory LOG (a moving "
+                                        "receiver, e.g. the file's SPP solution: docs/real_data.md)")
     importer.write(out_dir / "real.h5", imported)
     mask = inferred_mask_deg(real, ref)
     result = {"obs": Path(obs_path).name, "nav": [Path(n).name for n in nav_paths],
-              "reference": imported.report["reference"], "epochs": int(real["t"].size),
+              "reference": imported.report["reference"] if trajectory is None else
+              f"moving: the path of {Path(trajectory).name}" + (f" /solutions/{trajectory_solution}"
+                                                               if trajectory_solution else ""), "epochs": int(real["t"].size),
               "span_s": float(real["t"][-1]), "signals": real["signals"], "seed": seed}
-    result["default"] = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed, out_dir / "twin.h5", progress)
+    result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
+                                                      out_dir / "twin.h5", progress, arrays=True)
     if fit:
-        fitted = fit_parameters(real, ref)
-        result["fit_notes"] = fitted.pop("_notes")
-        fitted = rescale(fitted, result["default"])    # carrier and Doppler terms from the default twin
-        first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, out_dir / "twin_fit.h5", progress)
-        fitted = rescale(fitted, first)                # one refinement of the per-signal code factors
+        fitted, notes, extras = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5", progress,
+                                           (result["default"], real_grid, twin0))
+        result.update(extras)
+        result["fit_notes"] = notes
         result["fitted_parameters"] = fitted
         (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
         result["fitted"] = _twin_once(real, ref, nav_paths, mask, fitted, seed + 2, out_dir / "twin_fit.h5",
                                       progress)
+        result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress)
     (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
     return result
 

@@ -1,0 +1,89 @@
+"""[gnss.code_error_scale] as a table over elevation: the simulator's code sigma and code multipath are the
+unscaled ones times the factor interpolated at each satellite's elevation; malformed tables are one error."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from simkit.errors import ScenarioError
+from simkit.io import open_dataset, read_gnss
+from simkit.pipeline import run
+from simkit.scenario import load
+
+
+def _scenario(scale):
+    return {"scenario": {"name": "cs", "start": "2022-06-08T10:00:00Z", "duration_s": 600.0, "seed": 4},
+            "trajectory": {"rate_hz": 1.0, "origin": {"lat_deg": 55.0, "lon_deg": 12.5, "height_m": 50.0},
+                           "initial": {"speed_m_per_s": 0.0, "heading_deg": 0.0},
+                           "segment": [{"kind": "static", "duration_s": 600.0}]},
+            "gnss": {"rate_hz": 1.0, "elevation_mask_deg": 5.0, "signals": ["L1C", "L2W"],
+                     "constellation": [{"source": "nominal:gps"}],
+                     "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0]}], "code_error_scale": scale}}
+
+
+def _truth(path):
+    with open_dataset(path) as ds:
+        g = read_gnss(ds, antennas=0, truth=("elevation", "L1C/sigma_code", "L2W/sigma_code",
+                                             "L1C/multipath_code", "L2W/multipath_code"))
+    return g.truth
+
+
+def test_a_table_scales_code_sigma_and_multipath_by_the_factor_at_the_elevation(tmp_path):
+    table = {"elevation_deg": [10.0, 25.0, 35.0], "factor": [3.0, 1.0, 0.5]}
+    base = _truth(run(_scenario({}), out=tmp_path / "a.h5"))
+    scaled = _truth(run(_scenario({"L1C": table, "L2W": 0.25}), out=tmp_path / "b.h5"))
+    el = np.degrees(base["elevation"])
+    on = np.isfinite(base["L1C/sigma_code"])
+    assert on.sum() > 1000 and el[on].min() < 15 and el[on].max() > 40
+    factor = np.interp(el[on], table["elevation_deg"], table["factor"])
+    np.testing.assert_allclose(scaled["L1C/sigma_code"][on], base["L1C/sigma_code"][on] * factor, rtol=1e-12)
+    np.testing.assert_allclose(scaled["L1C/multipath_code"][on], base["L1C/multipath_code"][on] * factor,
+                               rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(scaled["L2W/sigma_code"][on], 0.25 * base["L2W/sigma_code"][on], rtol=1e-12)
+
+
+@pytest.mark.parametrize("table, key, words", [
+    ({"elevation_deg": [10.0, 5.0], "factor": [1.0, 2.0]}, "L1C.elevation_deg", "increasing"),
+    ({"elevation_deg": [10.0, 20.0], "factor": [1.0]}, "L1C.factor", "one factor per elevation"),
+    ({"elevation_deg": [10.0], "factor": [-1.0]}, "L1C.factor", ">= 0"),
+    ({"elevation_deg": [10.0], "factor": [1.0], "slope": 2}, "L1C.slope", "unknown key"),
+])
+def test_a_malformed_table_is_one_error_naming_the_key(table, key, words):
+    with pytest.raises(ScenarioError) as e:
+        load(_scenario({"L1C": table}))
+    assert f"gnss.code_error_scale.{key}" in str(e.value) and words in str(e.value)
+
+
+def test_an_antenna_gain_pattern_sets_cn0_by_the_angle_from_boresight(tmp_path):
+    """A level antenna: off-boresight = 90 deg - elevation, C/N0 = zenith + signal offset + the pattern there."""
+    from simkit.gnss import signals as sigmod
+
+    pattern = {"off_boresight_deg": [0.0, 40.0, 80.0], "gain_db": [2.0, -1.0, -15.0]}
+    sc = _scenario({})
+    sc["gnss"]["antenna"] = [{"lever_arm_m": [0.0, 0.0, 0.0], "gain_pattern": pattern}]
+    sc["gnss"]["cn0_zenith_dbhz"] = 44.0
+    with open_dataset(run(sc, out=tmp_path / "p.h5")) as ds:
+        g = read_gnss(ds, antennas=0, obs=("cn0",), truth=("elevation",))
+    el = np.degrees(g.truth["elevation"])
+    for name in ("L1C", "L2W"):
+        on = np.isfinite(g.obs["cn0"][name])
+        assert on.sum() > 1000
+        expected = 44.0 + sigmod.get(name).cn0_offset_db + np.interp(90.0 - el[on], pattern["off_boresight_deg"],
+                                                                       pattern["gain_db"])
+        np.testing.assert_allclose(g.obs["cn0"][name][on], expected, atol=1e-9)
+
+
+@pytest.mark.parametrize("antenna, key, words", [
+    ({"gain_pattern": {"off_boresight_deg": [0.0, 90.0], "gain_db": [0.0]}}, "gain_pattern.gain_db",
+     "one gain per angle"),
+    ({"gain_pattern": {"off_boresight_deg": [50.0, 10.0], "gain_db": [0.0, 1.0]}},
+     "gain_pattern.off_boresight_deg", "increasing"),
+    ({"gain_pattern": {"off_boresight_deg": [0.0], "gain_db": [0.0]}, "rolloff_db": 5.0}, "gain_pattern",
+     "cannot be given with rolloff_db"),
+])
+def test_a_malformed_gain_pattern_is_one_error_naming_the_key(antenna, key, words):
+    sc = _scenario({})
+    sc["gnss"]["antenna"] = [{"lever_arm_m": [0.0, 0.0, 0.0], **antenna}]
+    with pytest.raises(ScenarioError) as e:
+        load(sc)
+    assert f"gnss.antenna[0].{key}" in str(e.value) and words in str(e.value)
