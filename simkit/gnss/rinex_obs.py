@@ -3,7 +3,8 @@
 The result keeps the file's own content, per satellite system: every observation type as a (M, S_sys) array
 (NaN where blank), its loss-of-lock indicator (LLI, RINEX bits 0-2) and signal-strength indicator (SSI 1-9, 0
 blank). RINEX 2 two-character types are given their RINEX 3 names (C1 -> C1C, P1 -> C1W, L1 -> L1C, P2 -> C2W,
-L2 -> L2W, C2 -> C2X in 2.11 and C2W from 2.12, C5/L5 -> C5X/L5X; RINEX 2.11 sec. 5.1 and the RINEX 3.04
+L2 -> L2W, C2 -> C2X in 2.11 and C2W from 2.12, C5/L5 -> C5X/L5X; GLONASS C1/L1 -> C1C/L1C, P1 -> C1P,
+C2/L2 -> C2C/L2C, P2 -> C2P; RINEX 2.11 sec. 5.1 and the RINEX 3.04
 table 4 correspondence). :func:`signal_name` maps a system and RINEX 3 code to a simkit signal through the
 signal table of :mod:`.signals` (system, band digit, tracking attribute), so a signal added there is imported.
 
@@ -35,6 +36,13 @@ SUPPORTED_TIME_SYSTEMS = {"GPS": 0.0, "GAL": 0.0, "BDT": -gpstime.BDT_MINUS_GPST
 # RINEX 2 observation type -> RINEX 3 code for GPS (band digit and tracking attribute; sec. 5.1 of 2.11)
 _V2_GPS = {"C1": "C1C", "P1": "C1W", "L1": "L1C", "D1": "D1C", "S1": "S1C", "P2": "C2W", "L2": "L2W",
            "D2": "D2W", "S2": "S2W", "C5": "C5X", "L5": "L5X", "D5": "D5X", "S5": "S5X"}
+# and for GLONASS (C/A on G1 and G2, P code as P; RINEX 2.11 sec. 5.1, table A1)
+_V2_GLO = {"C1": "C1C", "P1": "C1P", "L1": "L1C", "D1": "D1C", "S1": "S1C",
+           "C2": "C2C", "P2": "C2P", "L2": "L2C", "D2": "D2C", "S2": "S2C"}
+# Attribute X (data and pilot components tracked together, RINEX 3.04 table 4) is the same carrier and ranging code
+# family as the pilot simkit models: (system, band) -> simkit's attribute
+_COMBINED = {("G", "5"): "Q", ("E", "1"): "C", ("E", "5"): "Q", ("E", "7"): "Q", ("E", "6"): "C",
+             ("C", "1"): "P", ("C", "5"): "P", ("J", "5"): "Q", ("J", "2"): "L"}
 
 
 @dataclass(frozen=True)
@@ -107,10 +115,14 @@ KINDS = {"C": "code", "L": "carrier", "D": "doppler", "S": "cn0"}
 
 def signal_name(system: str, code: str, version: float) -> str | None:
     """The simkit signal of RINEX 3 observation ``code`` (e.g. "C1C") of ``system`` ("G"), None when simkit has
-    no such signal. BDS B1I written with band 1 (RINEX 3.02: C1I, C1Q; C1X before 3.03) is band 2 of 3.03 on."""
+    no such signal. BDS B1I written with band 1 (RINEX 3.02: C1I, C1Q; C1X before 3.03) is band 2 of 3.03 on;
+    attribute X (data + pilot) is the pilot signal simkit models where it has one on that band (GPS L5, Galileo,
+    BDS B1C and B2a, QZSS L2C and L5)."""
     band, attr = code[1:2], code[2:3]
     if system == "C" and band == "1" and (attr in ("I", "Q") or (attr == "X" and version < 3.03)):
         band = "2"
+    elif attr == "X":
+        attr = _COMBINED.get((system, band), attr)
     for s in sigmod.SIGNALS.values():
         if s.system == system and s.rinex_band == band and s.rinex_attr == attr:
             return s.name
@@ -124,6 +136,8 @@ def _v2_code(sys: str, code: str, version: float) -> str:
             return "C2W" if version >= 2.12 else "C2X"
         if code in _V2_GPS:
             return _V2_GPS[code]
+    if sys == "R" and code in _V2_GLO:
+        return _V2_GLO[code]
     return code + "X" if len(code) == 2 else code
 
 
