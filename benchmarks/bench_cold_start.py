@@ -43,7 +43,7 @@ print(json.dumps({"import": t1 - t0, "first_ils": t3 - t2, "compiled_after": t4 
 
 
 def _env(cache_dir):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir), SIMKIT_NO_PREPARED_CACHE="1")  # `simkit compile`: not here
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
     return env
 

@@ -16,6 +16,7 @@ prepared files there first (an empty ``$NUMBA_CACHE_DIR``, a read-only install, 
 instead of compiling). The source stamp is the SHA-256 of the source file and numpy's version: a prepared
 cache survives a reinstall or a copy (new mtimes), and a cache from another source, numpy or numba version
 (numba's index records its version) or another CPU (numba's index key) is never loaded, only replaced.
+``SIMKIT_NO_PREPARED_CACHE=1`` turns the seeding off (what a first run costs without a prepared cache).
 """
 from __future__ import annotations
 
@@ -127,7 +128,9 @@ def _locator_base():
 
 
 class _Prepared:
-    """Mixed into numba's locator base by :func:`register` (numba is imported only then)."""
+    """The locator of simkit's kernels: numba's own choice of directory (``inner``, the first of numba's locators
+    that accepts the file), seeded from the prepared cache, with :func:`source_stamp`. :func:`register` makes
+    ``PreparedLocator`` of it and numba's locator base (numba is imported only then)."""
 
     def __init__(self, inner, py_func, py_file):
         self._inner, self._py_file = inner, py_file
@@ -162,7 +165,8 @@ class _Prepared:
             inner = other.from_function(py_func, py_file)
             if inner is not None:
                 self = cls(inner, py_func, py_file)
-                seed(self.prepared, self.get_cache_path(), self.base)
+                if not os.environ.get("SIMKIT_NO_PREPARED_CACHE"):
+                    seed(self.prepared, self.get_cache_path(), self.base)
                 return self
         return None
 
@@ -175,7 +179,8 @@ def register():
     simkit kernel is defined: numba picks a kernel's locator when the decorator runs."""
     global PreparedLocator
     if PreparedLocator is None:
-        PreparedLocator = type("PreparedLocator", (_Prepared, _locator_base()), {"__doc__": _Prepared.__doc__})
+        PreparedLocator = type("PreparedLocator", (_Prepared, _locator_base()),
+                               {"__doc__": _Prepared.__doc__, "__module__": __name__})
     classes = _numba_locators()
     if PreparedLocator not in classes:
         classes.insert(0, PreparedLocator)
