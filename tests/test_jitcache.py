@@ -164,3 +164,14 @@ def test_seed_copies_only_into_a_cache_without_the_kernel(tmp_path):
     (cache / "m.f-3.py311.nbi").write_text("newer")
     assert jitcache.seed(str(prepared), str(cache), "m.f-3.py311") == 0  # numba's own index is never replaced
     assert (cache / "m.f-3.py311.nbi").read_text() == "newer"
+
+
+def test_compile_into_an_install_it_cannot_write_is_one_line_exit_2(monkeypatch, tmp_path, capsys):
+    from simkit.cli import main
+
+    blocked = tmp_path / "site-packages"
+    blocked.touch()  # a file: nothing can be written below it
+    monkeypatch.setattr(jitcache, "PREPARED", blocked / "simkit" / "_jit")
+    assert main(["compile", "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(blocked / "simkit" / "_jit") in err[0] and "simkit compile" in err[0]
