@@ -161,6 +161,7 @@ def prepare_cache(progress: bool = False):
                 dst.parent.mkdir(parents=True, exist_ok=True)
                 shutil.copyfile(f, dst)
                 count += 1
+        (new / "SOURCES").write_text(jitcache.sources_digest() + "\n")  # what the seeding checks
     old = target.with_name("_jit.old")
     shutil.rmtree(old, ignore_errors=True)
     if target.exists():

@@ -14,7 +14,9 @@ simkit``) puts :class:`PreparedLocator` first in numba's list of cache locators,
 only: it keeps numba's choice of directory, and when that directory has no index for a kernel yet, copies the
 prepared files there first (an empty ``$NUMBA_CACHE_DIR``, a read-only install, a new user: numba then loads
 instead of compiling). The source stamp is the SHA-256 of the source file and numpy's version: a prepared
-cache survives a reinstall or a copy (new mtimes), and a cache from another source, numpy or numba version
+cache survives a reinstall or a copy (new mtimes). The prepared cache seeds only while the package's sources
+are those it was built from (:func:`sources_digest`, stored in ``_jit/SOURCES``); a cache from another source,
+numpy or numba version
 (numba's index records its version) or another CPU (numba's index key) is never loaded, only replaced.
 ``SIMKIT_NO_PREPARED_CACHE=1`` turns the seeding off (what a first run costs without a prepared cache).
 """
@@ -76,6 +78,25 @@ def source_stamp(py_file: str) -> tuple[str, str]:
 
     with open(py_file, "rb") as f:
         return hashlib.sha256(f.read()).hexdigest(), numpy.__version__
+
+
+def sources_digest(package: Path = _PACKAGE) -> str:
+    """SHA-256 over every ``.py`` file of the package (relative path and contents). ``simkit compile`` stores it
+    with the prepared cache, which seeds numba's only while the sources are still these: numba's stamp covers a
+    kernel's own file, not the callees compiled into it from other files."""
+    digest = hashlib.sha256()
+    for path in sorted(p for p in package.rglob("*.py") if PREPARED.name not in p.relative_to(package).parts):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+@functools.lru_cache(maxsize=None)
+def prepared_matches(prepared: str) -> bool:
+    """True when the prepared cache ``prepared`` was built from this package's sources (its ``SOURCES`` file)."""
+    try:
+        return Path(prepared, "SOURCES").read_text().strip() == sources_digest(Path(prepared).parent)
+    except OSError:
+        return False
 
 
 @functools.lru_cache(maxsize=None)
@@ -165,8 +186,11 @@ class _Prepared:
             inner = other.from_function(py_func, py_file)
             if inner is not None:
                 self = cls(inner, py_func, py_file)
-                if not os.environ.get("SIMKIT_NO_PREPARED_CACHE"):
-                    seed(self.prepared, self.get_cache_path(), self.base)
+                cache = self.get_cache_path()
+                if (not os.environ.get("SIMKIT_NO_PREPARED_CACHE")  # the digest only when there is a gap to fill
+                        and not os.path.exists(os.path.join(cache, self.base + ".nbi"))
+                        and prepared_matches(str(PREPARED))):
+                    seed(self.prepared, cache, self.base)
                 return self
         return None
 

@@ -100,6 +100,7 @@ def _prepare(site, tmp_path):
     prepared.mkdir(parents=True)
     for f in files:
         shutil.copyfile(f, prepared / f.name)
+    (package / "_jit" / "SOURCES").write_text(jitcache.sources_digest(package))  # as `simkit compile` does
     for p in [package, prepared.parent, prepared, *prepared.iterdir()]:  # read-only again, as in an image
         p.chmod(p.stat().st_mode & ~(stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH))
     return prepared
@@ -118,6 +119,16 @@ def test_a_prepared_cache_serves_a_read_only_install(read_only_install, tmp_path
     got = _child(read_only_install, XDG_CACHE_HOME=str(tmp_path / "user-cache"), TMPDIR=str(tmp_path))
     assert got["path"].startswith(str(tmp_path / "user-cache" / "numba"))
     assert got["hits"] == 1 and got["misses"] == 0
+
+
+def test_a_prepared_cache_of_other_sources_does_not_seed(read_only_install, tmp_path):
+    """A callee's source changed (kalman._chol compiles into its callers from another file): numba's stamp of
+    the caller's own file would still match, so the prepared cache as a whole is left aside."""
+    _prepare(read_only_install, tmp_path)
+    (read_only_install / "simkit" / "_jit" / "SOURCES").chmod(0o644)
+    (read_only_install / "simkit" / "_jit" / "SOURCES").write_text("0" * 64)
+    got = _child(read_only_install, NUMBA_CACHE_DIR=str(tmp_path / "empty"))
+    assert got["hits"] == 0 and got["misses"] == 1
 
 
 def test_a_prepared_cache_of_another_numpy_is_not_loaded(read_only_install, tmp_path):
