@@ -1,7 +1,8 @@
 """Cold and warm start of simkit.ambiguity.ils and of `simkit run quickstart`, each in a fresh subprocess.
 
-Run: python benchmarks/bench_cold_start.py [--repeat N]. "cold" = an empty NUMBA_CACHE_DIR (as right after
-install); "warm" = the same directory once a process has compiled and cached the kernels. Columns:
+Run: python benchmarks/bench_cold_start.py [--repeat N] [--prepared]. "cold" = an empty NUMBA_CACHE_DIR and no
+prepared cache (what numba compiles); with --prepared the empty directory is seeded from simkit/_jit as after
+`pip install .` (docs/cold_start.md); "warm" = the same directory once a process has cached the kernels. Columns:
 - import: `from simkit.ambiguity import ils`;
 - first ils: the first call (n = 10, a GNSS-like problem); cold, it runs the kernel interpreted while numba
   compiles in the background (simkit/ambiguity/warmup.py);
@@ -42,8 +43,13 @@ print(json.dumps({"import": t1 - t0, "first_ils": t3 - t2, "compiled_after": t4 
 """
 
 
+PREPARED = False  # --prepared: "cold" starts from the install's prepared cache (simkit/_jit, `simkit compile`)
+
+
 def _env(cache_dir):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir))
+    if not PREPARED:
+        env["SIMKIT_NO_PREPARED_CACHE"] = "1"  # a real compile, whatever this checkout's simkit/_jit holds
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
     return env
 
@@ -102,7 +108,12 @@ def measure(repeat=3):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
-    rows = measure(ap.parse_args().repeat)
+    ap.add_argument("--prepared", action="store_true",
+                    help="let the empty cache be seeded from simkit/_jit (run `python -m simkit compile` first)")
+    args = ap.parse_args()
+    global PREPARED
+    PREPARED = args.prepared
+    rows = measure(args.repeat)
     print(f"{'numba cache':<12} {'import s':>9} {'first ils s':>12} {'compiled after s':>17} {'quickstart s':>13} "
           f"{'(CPU s)':>8} {'solve s':>8} {'(CPU s)':>8}")
     for r in rows:

@@ -109,6 +109,69 @@ def kernels_cold(filters=None) -> bool:
     return not wanted <= cached
 
 
+# What `simkit compile` runs: the bundled quickstart (one antenna) and a 60 s Xi'an file (three antennas), each
+# simulated and solved by every filter, so that the kernels of a first `simkit run` / `simkit solve` are compiled
+_PREPARE = r"""
+import tempfile, tomllib
+from pathlib import Path
+import simkit
+from simkit.api import registry
+xian = tomllib.loads((Path(simkit.__file__).parent / "scenarios" / "xian_static_bds.toml").read_text())
+xian["scenario"]["duration_s"] = 60.0
+for segment in xian["trajectory"]["segment"]:
+    segment["duration_s"] = 60.0
+with tempfile.TemporaryDirectory() as tmp:
+    for name, scenario in (("quickstart", "quickstart"), ("xian", xian)):
+        path = simkit.run(scenario, out=f"{tmp}/{name}.h5")
+        simkit.solve(path, list(registry()), on_each=lambda *a: None)
+"""
+
+
+def prepare_cache(progress: bool = False):
+    """Compile the kernels a first run needs and store them as the prepared cache (``simkit/_jit``,
+    :mod:`simkit.jitcache`); returns (its path, number of files). Runs the work in a child process with its own
+    empty numba cache; the new tree replaces the old one only once complete. Several minutes of CPU."""
+    import os
+    import shutil
+    import subprocess
+    import tempfile
+    from pathlib import Path
+
+    from numba.core.caching import UserProvidedCacheLocator
+
+    from . import jitcache
+    from .errors import OutputError
+
+    target = jitcache.PREPARED
+    if not jitcache.writable(target.parent):
+        raise OutputError(str(target), "cannot be written: run `simkit compile` as the owner of the install")
+    with tempfile.TemporaryDirectory() as tmp:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "numba"))
+        env["PYTHONPATH"] = os.pathsep.join([str(target.parents[1])] + [p for p in [env.get("PYTHONPATH")] if p])
+        done = subprocess.run([sys.executable, "-c", _PREPARE], env=env, cwd=tmp,
+                              stderr=None if progress else subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+        if done.returncode:
+            raise SimkitError(f"simkit compile: the compile run failed (exit code {done.returncode})")
+        new = Path(tempfile.mkdtemp(prefix="_jit.", dir=target.parent))
+        count = 0
+        for source_dir in sorted({p.parent for p in target.parent.rglob("*.py")} - {target}):
+            sub = UserProvidedCacheLocator.get_suitable_cache_subpath(str(source_dir / "x.py"))
+            for f in (Path(env["NUMBA_CACHE_DIR"]) / sub).glob("*.nb[ic]"):
+                dst = new / source_dir.relative_to(target.parent) / f.name
+                dst.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(f, dst)
+                count += 1
+        (new / "SOURCES").write_text(jitcache.sources_digest() + "\n")  # what the seeding checks
+    old = target.with_name("_jit.old")
+    shutil.rmtree(old, ignore_errors=True)
+    if target.exists():
+        target.rename(old)
+    new.chmod(0o755)
+    new.rename(target)
+    shutil.rmtree(old, ignore_errors=True)
+    return target, count
+
+
 def _solve_one(path, solver, share, progress):
     """(Solution, None) or (None, why) for one filter; a failure on the file's data is its one-line reason."""
     from .io import open_dataset

@@ -16,7 +16,7 @@ from .errors import InputError, SimkitError
 from .version import __version__
 
 COMMANDS = ("run", "inspect", "solve", "validate", "score", "plot", "regress", "campaign", "allan", "sky", "rinex",
-            "export", "import", "twin")
+            "export", "import", "twin", "compile")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -77,7 +77,8 @@ print(json.dumps({"first_s": first, "cands": res.candidates.tolist(), "again": a
 @pytest.mark.slow
 def test_cold_first_ils_call_is_fast_and_right(tmp_path):
     case = VECTORS["large"]
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))  # empty: as right after install
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"),  # empty: as right after install
+               SIMKIT_NO_PREPARED_CACHE="1")  # and no `simkit compile` in this checkout: a real compile
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
     out = subprocess.run([sys.executable, "-c", CHILD], input=json.dumps(case), env=env, capture_output=True,
                          text=True, timeout=600, check=True)
@@ -116,7 +117,7 @@ def test_warm_cache_ils_is_compiled_from_the_first_call(tmp_path):
     call loads the cache (~0.2 s) in the caller's thread. With the cache loaded in a background thread instead,
     the first call returns while the interpreted twin is in use and the next calls run ~100x slower (measured
     here: 8 s against 8 ms), so both assertions fail."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), SIMKIT_NO_PREPARED_CACHE="1")
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
     run = lambda: json.loads(subprocess.run([sys.executable, "-c", WARM_CHILD], env=env, capture_output=True,
                                             text=True, timeout=600, check=True).stdout.strip().splitlines()[-1])

@@ -1,6 +1,7 @@
 """What the filter loop compiles on a cold numba cache (simkit/estimators/loop.py, module docstring): the Kalman
 loop leaves the H-infinity correction uncompiled, and each kernel it calls has one specialisation. Run in a
-fresh process with an empty NUMBA_CACHE_DIR (with a warm cache nothing compiles and there is nothing to see)."""
+fresh process with an empty NUMBA_CACHE_DIR and no prepared cache (with a warm cache nothing compiles and there
+is nothing to see)."""
 import json
 import os
 import subprocess
@@ -29,7 +30,7 @@ print(json.dumps({"specialisations": {f.__name__: len(f.signatures) for f in ker
 
 @pytest.mark.slow
 def test_the_kalman_loop_compiles_no_hinf_kernel_and_one_specialisation_each(tmp_path):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), SIMKIT_NO_PREPARED_CACHE="1")  # compiled
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
     out = subprocess.run([sys.executable, "-c", CHILD], env=env, capture_output=True, text=True, timeout=900)
     assert out.returncode == 0, out.stderr

@@ -213,7 +213,7 @@ def test_a_cold_numba_cache_is_announced_once(small, tmp_path):
 
     from cli_errors import ROOT
 
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"),
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), SIMKIT_NO_PREPARED_CACHE="1",
                PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
     cold = "from simkit.api import kernels_cold; print(kernels_cold([\"kf15\"]))"
     probe = lambda: subprocess.run([sys.executable, "-c", cold], env=env, capture_output=True, text=True,  # noqa: E731
