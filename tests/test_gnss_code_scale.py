@@ -87,3 +87,44 @@ def test_a_malformed_gain_pattern_is_one_error_naming_the_key(antenna, key, word
     with pytest.raises(ScenarioError) as e:
         load(sc)
     assert f"gnss.antenna[0].{key}" in str(e.value) and words in str(e.value)
+
+
+def test_a_receivers_cn0_offset_moves_that_signals_cn0_and_its_noise(tmp_path):
+    """[gnss.cn0_offset_db] L2W = -3: L2W's C/N0 3 dB lower at every satellite-epoch, its DLL code sigma up by the
+    DLL jitter's C/N0 law, L1C untouched bit for bit; without the key the arrays are those of a file without it."""
+    from simkit.gnss import noise as noise_model
+    from simkit.gnss import signals as sigmod
+
+    def arrays(path):
+        with open_dataset(path) as ds:
+            return read_gnss(ds, antennas=0, obs=("cn0", "code"), truth=("L1C/sigma_code", "L2W/sigma_code"))
+
+    sc = _scenario({})
+    sc["gnss"]["multipath"] = {"code_sigma_m": 0.0}
+    base = arrays(run(sc, out=tmp_path / "a.h5"))
+    sc["gnss"]["cn0_offset_db"] = {"L2W": -3.0}
+    moved = arrays(run(sc, out=tmp_path / "b.h5"))
+    on = np.isfinite(base.obs["cn0"]["L2W"])
+    assert on.sum() > 1000
+    np.testing.assert_allclose(moved.obs["cn0"]["L2W"][on], base.obs["cn0"]["L2W"][on] - 3.0, atol=1e-9)
+    assert np.array_equal(moved.obs["cn0"]["L1C"], base.obs["cn0"]["L1C"], equal_nan=True)
+    assert np.array_equal(moved.truth["L1C/sigma_code"], base.truth["L1C/sigma_code"], equal_nan=True)
+    g = sigmod.get("L2W")
+    cfg = load(sc).gnss.noise
+
+    def dll(cn0):
+        return noise_model.dll_sigma_m(cn0, g.chip_length_m, cfg.dll_bandwidth_hz, cfg.correlator_spacing_chips,
+                                       cfg.integration_time_s)
+    ratio = dll(moved.obs["cn0"]["L2W"][on]) / dll(base.obs["cn0"]["L2W"][on])
+    np.testing.assert_allclose(moved.truth["L2W/sigma_code"][on] / base.truth["L2W/sigma_code"][on], ratio,
+                               rtol=1e-9)
+
+
+@pytest.mark.parametrize("table, words", [({"L2W": 45.0}, "[-30.0, 30.0]"), ({"L5Q": 1.0}, "unknown key"),
+                                          ({"L1C": "high"}, "L1C")])
+def test_a_malformed_cn0_offset_is_one_error_naming_the_key(table, words):
+    sc = _scenario({})
+    sc["gnss"]["cn0_offset_db"] = table
+    with pytest.raises(ScenarioError) as e:
+        load(sc)
+    assert "gnss.cn0_offset_db" in str(e.value) and words in str(e.value)

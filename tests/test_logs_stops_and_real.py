@@ -98,7 +98,8 @@ def test_a_real_receivers_spp_replayed_as_the_trajectory(tmp_path):
     obs = DATA / "rinex_obs" / "Berlin_Potsdamer_Platz_60ep.obs"
     nav = ROOT / "simkit" / "data" / "BRDC00WRD_U_20161580000_01D_MN.rnx.gz"
     _run("import", obs, "--nav", nav, "-o", tmp_path / "berlin.h5", cwd=ROOT)
-    _run("solve", tmp_path / "berlin.h5", "--filter", "spp", cwd=ROOT)
+    # GPS only: the track the closure bound below was measured on (the file's GLONASS G1C makes a jerkier one)
+    _run("solve", tmp_path / "berlin.h5", "--filter", "spp", "--set", 'estimator.systems="G"', cwd=ROOT)
     spp = read_solution(tmp_path / "berlin.h5", "spp")
     import simkit
     with simkit.open(tmp_path / "berlin.h5") as ds:

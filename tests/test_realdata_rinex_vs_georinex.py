@@ -93,3 +93,16 @@ def test_signal_mapping_follows_the_signal_table():
     assert rinex_obs.signal_name("E", "C5Q", 3.04) == "E5aQ"
     assert rinex_obs.signal_name("J", "C1C", 3.04) == "J1C"          # QZSS L1 C/A: its own name
     assert rinex_obs.signal_name("S", "C1C", 3.04) is None           # SBAS: not simulated
+
+
+def test_rinex2_glonass_types_follow_the_tracked_code():
+    """RINEX 2.11 sec. 5.1: C1/C2 are the C/A codes, P1/P2 the P codes; a phase (Doppler, strength) belongs to the
+    C/A code unless the band has a P code (on G1: and no C/A code), since a P-code phase is a quarter cycle off."""
+    f = rinex_obs._v2_code
+    assert [f("R", c, 2.11, ["C1", "L1", "S1", "D1"]) for c in ("C1", "L1", "S1", "D1")] == ["C1C", "L1C", "S1C", "D1C"]
+    geodetic = ["C1", "P1", "L1", "P2", "L2"]
+    assert [f("R", c, 2.11, geodetic) for c in geodetic] == ["C1C", "C1P", "L1C", "C2P", "L2P"]
+    assert [f("R", c, 2.11, ["C1", "C2", "L2"]) for c in ("C2", "L2")] == ["C2C", "L2C"]
+    assert f("R", "L1", 2.11, ["P1", "L1"]) == "L1P"
+    assert [rinex_obs.signal_name("R", f("R", c, 2.11, geodetic), 2.11) for c in geodetic] == ["G1C", None, "G1C",
+                                                                                               None, None]

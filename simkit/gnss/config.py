@@ -85,6 +85,7 @@ class GnssConfig:
     ambiguity_max_cycles: int
     iono_coefficients: dict[str, tuple] = field(default_factory=dict)  # "gps"/"bds" -> (alpha, beta) overrides
     code_error_scale: dict = field(default_factory=dict)  # signal -> factor (or (el_deg, factor) table) on code noise + multipath
+    cn0_offset_db: dict = field(default_factory=dict)  # signal -> dB added to the signal table's C/N0 offset
     truth_errors: TruthErrorsConfig | None = None  # departures of the truth from the receiver's models; None: off
 
     @property
@@ -131,6 +132,7 @@ def parse_config(sec: Section) -> GnssConfig:
         ambiguity_max_cycles=sec.get("ambiguity_max_cycles", int, 100000, check=in_range(0, 10**8)),
         iono_coefficients=_ionosphere(sec.section("ionosphere")),
         code_error_scale=_code_scale(sec.section("code_error_scale"), sigs),
+        cn0_offset_db=_cn0_offset(sec.section("cn0_offset_db"), sigs),
         truth_errors=parse_truth_errors(sec.section("truth_errors")))
     sec.done()
     return cfg
@@ -242,6 +244,15 @@ def _code_scale(cs: Section, sigs: list[str]) -> dict:
             out[name] = value
     cs.done()
     return out
+
+
+def _cn0_offset(cs: Section, sigs: list[str]) -> dict:
+    """[gnss.cn0_offset_db]: signal name -> dB (in [-30, 30]) added to that signal's C/N0 offset of the signal
+    table: the C/N0 a receiver reports differs by system and code beyond the received power (its correlator
+    losses, its estimator; ``simkit twin --fit`` estimates them)."""
+    out = {name: cs.get(name, float, None, check=in_range(-30.0, 30.0)) for name in sigs}
+    cs.done()
+    return {k: v for k, v in out.items() if v is not None}
 
 
 def _code_scale_table(t: Section) -> tuple:

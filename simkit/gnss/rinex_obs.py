@@ -4,7 +4,7 @@ The result keeps the file's own content, per satellite system: every observation
 (NaN where blank), its loss-of-lock indicator (LLI, RINEX bits 0-2) and signal-strength indicator (SSI 1-9, 0
 blank). RINEX 2 two-character types are given their RINEX 3 names (C1 -> C1C, P1 -> C1W, L1 -> L1C, P2 -> C2W,
 L2 -> L2W, C2 -> C2X in 2.11 and C2W from 2.12, C5/L5 -> C5X/L5X; GLONASS C1/L1 -> C1C/L1C, P1 -> C1P,
-C2/L2 -> C2C/L2C, P2 -> C2P; RINEX 2.11 sec. 5.1 and the RINEX 3.04
+C2 -> C2C, P2 -> C2P, the G2 phase with the C/A code only when the file has no P2; RINEX 2.11 sec. 5.1 and the RINEX 3.04
 table 4 correspondence). :func:`signal_name` maps a system and RINEX 3 code to a simkit signal through the
 signal table of :mod:`.signals` (system, band digit, tracking attribute), so a signal added there is imported.
 
@@ -36,13 +36,8 @@ SUPPORTED_TIME_SYSTEMS = {"GPS": 0.0, "GAL": 0.0, "BDT": -gpstime.BDT_MINUS_GPST
 # RINEX 2 observation type -> RINEX 3 code for GPS (band digit and tracking attribute; sec. 5.1 of 2.11)
 _V2_GPS = {"C1": "C1C", "P1": "C1W", "L1": "L1C", "D1": "D1C", "S1": "S1C", "P2": "C2W", "L2": "L2W",
            "D2": "D2W", "S2": "S2W", "C5": "C5X", "L5": "L5X", "D5": "D5X", "S5": "S5X"}
-# and for GLONASS (C/A on G1 and G2, P code as P; RINEX 2.11 sec. 5.1, table A1)
-_V2_GLO = {"C1": "C1C", "P1": "C1P", "L1": "L1C", "D1": "D1C", "S1": "S1C",
-           "C2": "C2C", "P2": "C2P", "L2": "L2C", "D2": "D2C", "S2": "S2C"}
-# Attribute X (data and pilot components tracked together, RINEX 3.04 table 4) is the same carrier and ranging code
-# family as the pilot simkit models: (system, band) -> simkit's attribute
-_COMBINED = {("G", "5"): "Q", ("E", "1"): "C", ("E", "5"): "Q", ("E", "7"): "Q", ("E", "6"): "C",
-             ("C", "1"): "P", ("C", "5"): "P", ("J", "5"): "Q", ("J", "2"): "L"}
+# and for GLONASS codes: C/A on G1 and G2, P code as P (RINEX 2.11 sec. 5.1)
+_V2_GLO = {"C1": "C1C", "P1": "C1P", "C2": "C2C", "P2": "C2P"}
 
 
 @dataclass(frozen=True)
@@ -115,29 +110,31 @@ KINDS = {"C": "code", "L": "carrier", "D": "doppler", "S": "cn0"}
 
 def signal_name(system: str, code: str, version: float) -> str | None:
     """The simkit signal of RINEX 3 observation ``code`` (e.g. "C1C") of ``system`` ("G"), None when simkit has
-    no such signal. BDS B1I written with band 1 (RINEX 3.02: C1I, C1Q; C1X before 3.03) is band 2 of 3.03 on;
-    attribute X (data + pilot) is the pilot signal simkit models where it has one on that band (GPS L5, Galileo,
-    BDS B1C and B2a, QZSS L2C and L5)."""
+    no such signal. BDS B1I written with band 1 (RINEX 3.02: C1I, C1Q; C1X before 3.03) is band 2 of 3.03 on."""
     band, attr = code[1:2], code[2:3]
     if system == "C" and band == "1" and (attr in ("I", "Q") or (attr == "X" and version < 3.03)):
         band = "2"
-    elif attr == "X":
-        attr = _COMBINED.get((system, band), attr)
     for s in sigmod.SIGNALS.values():
         if s.system == system and s.rinex_band == band and s.rinex_attr == attr:
             return s.name
     return None
 
 
-def _v2_code(sys: str, code: str, version: float) -> str:
-    """A RINEX 2 observation type as a RINEX 3 code (systems other than GPS: the band digit and attribute X)."""
+def _v2_code(sys: str, code: str, version: float, types=()) -> str:
+    """A RINEX 2 observation type as a RINEX 3 code (``types`` all the file's types; systems other than GPS and
+    GLONASS: the band digit and attribute X)."""
     if sys == "G":
         if code == "C2":
             return "C2W" if version >= 2.12 else "C2X"
         if code in _V2_GPS:
             return _V2_GPS[code]
-    if sys == "R" and code in _V2_GLO:
-        return _V2_GLO[code]
+    if sys == "R":
+        if code in _V2_GLO:
+            return _V2_GLO[code]
+        if code[0] in "LDS" and code[1:] in ("1", "2"):
+            # a P-code phase is a quarter cycle off the C/A one: C/A unless the band has a P code (on G1: and no C/A)
+            b = code[1]
+            return code + ("C" if f"P{b}" not in types or (b == "1" and "C1" in types) else "P")
     return code + "X" if len(code) == 2 else code
 
 
@@ -231,7 +228,8 @@ class _HeaderState:
                 raise DataFileError(path, f"'# / TYPES OF OBSERV' announces {self.n_v2} types, lists "
                                     f"{len(self.v2_types)}", i)
             systems = {"G", "R", "E", "S", "C", "J", "I"} if self.file_sys == "M" else {self.file_sys}
-            self.types = {s: [_v2_code(s, c, self.version) for c in self.v2_types] for s in sorted(systems)}
+            self.types = {s: [_v2_code(s, c, self.version, self.v2_types) for c in self.v2_types]
+                          for s in sorted(systems)}
         elif not self.types:
             raise DataFileError(path, "missing 'SYS / # / OBS TYPES' header record", i)
         self._check_pending(i)

@@ -390,11 +390,11 @@ class _Parts:
         cj = np.flatnonzero(sim.carries[self.cand, j])
         cols = self.cand[cj]
         rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
-        cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, g.cn0_offset_db)
+        cn0_off = g.cn0_offset_db + cfg.cn0_offset_db.get(g.name, 0.0)
+        cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, cn0_off)
         for a, ant in enumerate(cfg.antennas):
             if ant.gain_pattern is not None:
-                cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern,
-                                                   g.cn0_offset_db)
+                cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern, cn0_off)
         freq = sim.freq[cols, j]                                                    # (C,) Hz
         lam = C_LIGHT / freq if g.is_fdma else g.wavelength_m
         sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g, lam))

@@ -99,6 +99,7 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                                  if p.get("gain_pattern") else {"rolloff_db": p["rolloff_db"]})}],
                  "noise": {"dll_bandwidth_hz": p["dll_bandwidth_hz"], "pll_bandwidth_hz": p["pll_bandwidth_hz"],
                            "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
+                 "cn0_offset_db": dict(p.get("cn0_offset_db", {})),
                  "code_error_scale": {k: {"elevation_deg": list(v[0]), "factor": list(v[1])}
                                       if isinstance(v, tuple) else v for k, v in p.get("code_error_scale", {}).items()},
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
@@ -181,7 +182,13 @@ def compare(real: dict, twin: dict, reference, mask_deg: float) -> dict:
            "real": {k: v for k, v in rs.items() if k != "_series"},
            "twin": {k: v for k, v in ts.items() if k != "_series"},
            "satellites_without_orbit": real.get("not_in_twin", [])}
-    out["cn0_rms_difference_dbhz"] = {s: _rms_diff(rs["cn0_dbhz"][s], ts["cn0_dbhz"][s]) for s in real["signals"]}
+    # C/N0 over the satellite-epochs both track: a satellite only the twin sees (a building the twin does not
+    # model) has no real C/N0 to compare with
+    both = {s: np.isfinite(real["obs"]["cn0"][s]) & np.isfinite(twin["obs"]["cn0"][s]) for s in real["signals"]}
+    common = {s: (fidelity.by_elevation(np.where(both[s], real["obs"]["cn0"][s], np.nan), el),
+                  fidelity.by_elevation(np.where(both[s], twin["obs"]["cn0"][s], np.nan), el)) for s in real["signals"]}
+    out["cn0_dbhz_common"] = {s: {"real": r, "twin": t} for s, (r, t) in common.items()}
+    out["cn0_rms_difference_dbhz"] = {s: _rms_diff(*common[s]) for s in real["signals"]}
     out["code_noise_ratio"] = {s: _ratios(ts["code_noise_m"][s], rs["code_noise_m"][s]) for s in real["signals"]}
     return out
 
@@ -223,7 +230,7 @@ def fit_parameters(real: dict, reference) -> dict:
     dt = float(np.median(np.diff(real["t"]))) if real["t"].size > 1 else 1.0
 
     def cn0_at(g, e):
-        return noise_model.cn0_dbhz(np.pi / 2 - e, p["cn0_zenith_dbhz"], p["rolloff_db"], g.cn0_offset_db)
+        return noise_model.cn0_dbhz(np.pi / 2 - e, p["cn0_zenith_dbhz"], p["rolloff_db"], _cn0_offset(g, p))
 
     code = _fit_code(st, sigs, centres, lambda g, c: noise_model.dll_sigma_m(
         cn0_at(g, c), g.chip_length_m, p["dll_bandwidth_hz"], p["correlator_spacing_chips"], p["integration_time_s"]))
@@ -248,23 +255,38 @@ def fit_parameters(real: dict, reference) -> dict:
 
 
 def _fit_cn0(real, sigs, el, p) -> bool:
-    """Set ``p``'s zenith C/N0, rolloff and gain pattern from the real C/N0 (least squares of the quadratic
-    model, then :func:`_gain_pattern`); False when the file has no signal strength."""
-    rows_x, rows_y = [], []
+    """Set ``p``'s zenith C/N0, rolloff, per-signal C/N0 offsets and gain pattern from the real C/N0 (least
+    squares of the quadratic model with one offset per signal beyond the first, relative to the signal table's,
+    then :func:`_gain_pattern`); False when the file has no signal strength."""
+    rows_x, rows_y, names = [], [], []
     for g in sigs:
         c = real["obs"]["cn0"][g.name]
         ok = np.isfinite(c) & np.isfinite(el)
         if ok.any():
             x = ((np.pi / 2 - el[ok]) / (np.pi / 2)) ** 2
-            rows_x.append(np.column_stack([np.ones(x.size), -x]))
+            rows_x.append((np.ones(x.size), -x))
             rows_y.append(c[ok] - g.cn0_offset_db)
+            names.append(g.name)
     if not rows_x:
         return False
-    sol = np.linalg.lstsq(np.vstack(rows_x), np.concatenate(rows_y), rcond=None)[0]
+    a = np.zeros((sum(r[0].size for r in rows_x), 1 + len(names)))
+    at = 0
+    for k, (one, x) in enumerate(rows_x):
+        a[at:at + one.size, 0], a[at:at + one.size, 1] = one, x
+        if k:
+            a[at:at + one.size, 1 + k] = 1.0
+        at += one.size
+    sol = np.linalg.lstsq(a, np.concatenate(rows_y), rcond=None)[0]
     p["cn0_zenith_dbhz"] = float(np.clip(sol[0], 10.0, 70.0))
     p["rolloff_db"] = float(max(sol[1], 0.0))
+    p["cn0_offset_db"] = {n: float(np.clip(v, -30.0, 30.0)) for n, v in zip(names[1:], sol[2:])}
     p["gain_pattern"] = _gain_pattern(real, sigs, el, p)
     return True
+
+
+def _cn0_offset(g, p) -> float:
+    """Signal ``g``'s C/N0 offset (dB): the signal table's plus the fitted one of ``p``."""
+    return g.cn0_offset_db + p.get("cn0_offset_db", {}).get(g.name, 0.0)
 
 
 def _gain_pattern(real, sigs, el, p) -> tuple:
@@ -274,7 +296,7 @@ def _gain_pattern(real, sigs, el, p) -> tuple:
     minimum count takes the quadratic rolloff at its centre. Steps, not a line through the bins' centres: the
     satellites of a short file sit anywhere in their bin, and the comparison is per bin."""
     edges = fidelity.ELEVATION_EDGES_DEG
-    pooled = np.concatenate([real["obs"]["cn0"][g.name] - g.cn0_offset_db for g in sigs], axis=1)
+    pooled = np.concatenate([real["obs"]["cn0"][g.name] - _cn0_offset(g, p) for g in sigs], axis=1)
     mean = fidelity.by_elevation(pooled, np.tile(el, (1, len(sigs))))
     off, gain = [], []
     for lo, hi, m in reversed(list(zip(edges[:-1], edges[1:], mean))):
@@ -379,6 +401,8 @@ def toml_fragment(p: dict) -> str:
              f"elevation_scale_deg = {p['mp_elevation_scale_deg']:.2f}",
              f"correlation_time_s = {p['mp_correlation_time_s']:.1f}", "",
              "[gnss.code_error_scale]", *(f"{k} = {_scale_toml(v)}" for k, v in p.get("code_error_scale", {}).items()),
+             "", "# the receiver's C/N0 per signal beyond the signal table's offsets",
+             "[gnss.cn0_offset_db]", *(f"{k} = {v:.2f}" for k, v in p.get("cn0_offset_db", {}).items()),
              "",
              "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]",
              f"rolloff_db = {p['rolloff_db']:.2f}" if not p.get("gain_pattern") else
