@@ -5,7 +5,7 @@ from . import jitcache
 from .version import __version__
 
 jitcache.choose()  # before any numba kernel is defined: a read-only install still caches them
-jitcache.register()  # the prepared cache (`simkit compile`) seeds numba's, content-keyed
+jitcache.register_when_numba_loads()  # the prepared cache (`simkit compile`) seeds numba's, content-keyed
 
 __all__ = ["__version__", "campaign", "open", "run", "score", "solve", "validate"]
 

@@ -209,3 +209,46 @@ def register():
     if PreparedLocator not in classes:
         classes.insert(0, PreparedLocator)
     return PreparedLocator
+
+
+class _RegisterAfterNumba:
+    """A ``sys.meta_path`` finder that calls :func:`register` right after numba's package has been executed, so
+    that ``import simkit`` does not import numba (a truth + IMU run never needs it) and still every simkit kernel,
+    defined after numba is imported, gets the locator."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name != "numba":
+            return None
+        import importlib.util
+
+        sys.meta_path.remove(self)
+        spec = importlib.util.find_spec(name)
+        if spec is not None and spec.loader is not None:
+            spec.loader = _ThenRegister(spec.loader)
+        return spec
+
+
+class _ThenRegister:
+    """numba's loader, then :func:`register`."""
+
+    def __init__(self, loader):
+        self._loader = loader
+
+    def create_module(self, spec):
+        return self._loader.create_module(spec)
+
+    def exec_module(self, module):
+        self._loader.exec_module(module)
+        register()
+
+    def __getattr__(self, name):
+        return getattr(self._loader, name)
+
+
+def register_when_numba_loads() -> None:
+    """:func:`register` now when numba is imported already, else right after it is (once)."""
+    if "numba" in sys.modules:
+        register()
+    elif not any(isinstance(f, _RegisterAfterNumba) for f in sys.meta_path):
+        sys.meta_path.insert(0, _RegisterAfterNumba())
+

@@ -186,3 +186,15 @@ def test_compile_into_an_install_it_cannot_write_is_one_line_exit_2(monkeypatch,
     assert main(["compile", "-q"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(blocked / "simkit" / "_jit") in err[0] and "simkit compile" in err[0]
+
+
+def test_import_simkit_leaves_numba_unimported_and_its_kernels_still_get_the_locator():
+    """``import simkit`` must not import numba (a truth + IMU run never needs it); the prepared-cache locator is
+    registered as numba's package finishes loading, before any simkit kernel is defined."""
+    code = ("import sys, simkit; assert 'numba' not in sys.modules; "
+            "from simkit.estimators import loop; from simkit import jitcache; "
+            "print(type(loop.run._cache._impl.locator) is jitcache.PreparedLocator)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "True"
