@@ -15,8 +15,7 @@ import pytest
 
 import pyrtklib
 from conftest import DATA
-from test_constellation_systems_rtklib import GPS_1980_UNIX, _rtklib_nav, _sat_id
-from simkit import gpstime
+from rtklib_nav import gpst, rtklib_nav, sat_id
 from simkit.constellation import load
 from simkit.errors import DataFileError
 
@@ -31,9 +30,9 @@ def _inav_records(nav):
     out = {}
     for i in range(nav.n):
         eph = nav.eph[i]
-        sid = _sat_id(eph.sat)
+        sid = sat_id(eph.sat)
         if sid.startswith("E") and not eph.code & 2 and eph.svh == 0:
-            out.setdefault(sid, []).append((eph.toe.time - GPS_1980_UNIX + eph.toe.sec, eph))
+            out.setdefault(sid, []).append((gpst(eph.toe), eph))
     return {k: sorted(v, key=lambda r: r[0]) for k, v in out.items()}
 
 
@@ -69,7 +68,7 @@ def _gsc_xml(records, t0a_abs, issue="2026-04-27T09:47:00.0Z"):
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("gsc")
-    nav = _rtklib_nav(NAV, tmp)
+    nav = rtklib_nav(NAV, tmp)
     records = _inav_records(nav)
     path = tmp / "2026-04-27.xml"
     path.write_text(_gsc_xml(records, 2416 * 604800.0 + T0A_SOW))
