@@ -35,15 +35,7 @@ print(" ".join(f"{x:.3f}" for x in row))
 
 
 def main(argv=None) -> int:
-    import argparse
-
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("a")
-    ap.add_argument("b")
-    ap.add_argument("--rounds", type=int, default=3)
-    args = ap.parse_args(argv)
-    timing.ab([args.a, args.b], PROBE, ["kf15 CPU s", "hinf CPU s"], args.rounds, ROOT / "benchmarks", own_cache=True)
-    return 0
+    return timing.ab_main(__doc__, PROBE, ["kf15 CPU s", "hinf CPU s"], argv, ROOT / "benchmarks", own_cache=True)
 
 
 if __name__ == "__main__":

@@ -48,15 +48,7 @@ print(" ".join(f"{x:.1f}" for x in row))
 
 
 def main(argv=None) -> int:
-    import argparse
-
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("a")
-    ap.add_argument("b")
-    ap.add_argument("--rounds", type=int, default=3)
-    args = ap.parse_args(argv)
-    timing.ab([args.a, args.b], PROBE, ["n=10 us", "n=20 us", "n=40 us"], args.rounds, ROOT)
-    return 0
+    return timing.ab_main(__doc__, PROBE, ["n=10 us", "n=20 us", "n=40 us"], argv, ROOT)
 
 
 if __name__ == "__main__":

@@ -55,3 +55,16 @@ def ab(trees, probe: str, columns, rounds: int = 3, extra_path=None, own_cache: 
                 print(f"{str(tree):<30} " + " ".join(f"{v:>11}" for v in figures))
     print(f"load average (1 min): {os.getloadavg()[0]:.1f}")
     return rows
+
+
+def ab_main(doc: str, probe: str, columns, argv=None, extra_path=None, own_cache: bool = False) -> int:
+    """The command line of an A/B benchmark (``A B [--rounds N]``) around :func:`ab`; ``doc`` its description."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("a")
+    ap.add_argument("b")
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args(argv)
+    ab([args.a, args.b], probe, columns, args.rounds, extra_path, own_cache=own_cache)
+    return 0
