@@ -30,16 +30,15 @@ from pathlib import Path  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from distributed import LocalCluster  # noqa: E402
-
 from simkit.campaign import DEFAULT_METRICS, plan, run_campaign  # noqa: E402
+from simkit.campaign.runner import local_cluster  # noqa: E402
 from simkit.campaign.task import execute  # noqa: E402
 
 
 def _dask(tmp: Path, runs: int, over: list[str], workers: int) -> float:
-    """Campaign time on a warm local cluster of ``workers`` processes (start-up and first imports excluded)."""
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR) as cluster:
+    """Campaign time on a warm local cluster of ``workers`` processes, built as ``simkit campaign`` builds it
+    (start-up and first imports excluded)."""
+    with local_cluster(workers, silence_logs=logging.ERROR) as cluster:
         address = cluster.scheduler_address
         run_campaign("xian_static_bds", tmp / f"warm{workers}", workers, first_seed=10**6, overrides=over,
                      scheduler=address)

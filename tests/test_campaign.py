@@ -184,6 +184,41 @@ def test_index_file_holds_the_run_table_and_virtual_datasets_over_the_runs(tmp_p
             np.testing.assert_array_equal(gyro[1], run["imu/gyro"][...])
 
 
+def test_index_from_the_workers_recorded_layouts_equals_the_index_from_walking_the_files(tmp_path):
+    """The client stacks the runs from the layouts the workers recorded; the result must be the index that walking
+    the files gives (same stacked paths, shapes, dtypes and values), and a layout that disagrees between runs
+    leaves that path unstacked, as a file that disagrees does."""
+    import h5py
+
+    import simkit
+    from simkit.campaign.index import write_index
+    from simkit.campaign.task import dataset_layout
+    from simkit.io import open_dataset
+
+    rows, records = [], {}
+    for seed in (3, 4):
+        (tmp_path / "runs").mkdir(exist_ok=True)
+        simkit.run("quickstart", out=tmp_path / "runs" / f"s{seed}.h5", seed=seed, overrides=["scenario.duration_s=2"])
+        rows.append({"run_id": f"s{seed}", "status": "ok", "file": f"runs/s{seed}.h5", "sha256": "x", "seed": seed,
+                     "point": 0, "elapsed_s": 1.0, "metrics": {}})
+        with open_dataset(tmp_path / "runs" / f"s{seed}.h5") as ds:
+            records[f"s{seed}"] = {"datasets": dataset_layout(ds)}
+    walked = write_index(tmp_path, rows)
+    with h5py.File(tmp_path / "index.h5", "r") as f:
+        expect = {k: (v.shape, v.dtype, v[...]) for k, v in f["campaign/virtual"].items()}
+    assert write_index(tmp_path, rows, records) == walked
+    with h5py.File(tmp_path / "index.h5", "r") as f:
+        got = f["campaign/virtual"]
+        assert sorted(got) == sorted(expect)
+        for k, (shape, dtype, values) in expect.items():
+            assert got[k].shape == shape and got[k].dtype == dtype
+            np.testing.assert_array_equal(got[k][...], values)
+    records["s4"]["datasets"]["imu/gyro"][0][0] += 1   # a run of another length: not stackable
+    assert "imu/gyro" not in write_index(tmp_path, rows, records) and "imu/accel" in walked
+    del records["s4"]["datasets"]                      # a record of an older simkit: the files are walked
+    assert write_index(tmp_path, rows, records) == walked
+
+
 FAULT_PROBE = r"""
 import resource, sys
 import numpy as np

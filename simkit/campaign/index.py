@@ -17,9 +17,16 @@ def index_columns(rows: list[dict]) -> dict[str, list]:
     return cols
 
 
-def write_index(out: Path, rows: list[dict]) -> list[str]:
-    """Write ``out/index.h5`` for the runs ``rows``; returns the dataset paths stacked as virtual datasets."""
-    files = [out / r["file"] for r in rows if r["status"] == "ok"]
+def write_index(out: Path, rows: list[dict], records: dict | None = None) -> list[str]:
+    """Write ``out/index.h5`` for the runs ``rows``; returns the dataset paths stacked as virtual datasets.
+
+    ``records`` (run_id -> record): the dataset layouts the workers recorded (``datasets``) are used when every
+    completed run has one; otherwise (records of an older simkit) the run files are walked."""
+    done = [r for r in rows if r["status"] == "ok"]
+    files = [out / r["file"] for r in done]
+    layouts = [(records or {}).get(r["run_id"], {}).get("datasets") for r in done]
+    if files and all(isinstance(lay, dict) for lay in layouts):
+        return write_campaign_index(out / "index.h5", index_columns(rows), files, list(layouts[0]), layouts)
     paths = []
     if files:
         with open_dataset(files[0]) as ds:

@@ -95,13 +95,20 @@ def execute(spec: RunSpec, run_dir: str, metric_names: tuple[str, ...], previous
             metrics = dict(previous.get("metrics", {}))
         with one_thread(), open_dataset(h5) as ds:
             metrics.update(evaluate(ds, [m for m in metric_names if m not in metrics]))
+            layout = dataset_layout(ds)
         rec.update(status="ok", sha256=previous["sha256"] if previous else file_digest(h5), metrics=metrics,
-                   elapsed_s=(previous or {}).get("elapsed_s", time.perf_counter() - t0))
+                   elapsed_s=(previous or {}).get("elapsed_s", time.perf_counter() - t0), datasets=layout)
     except Exception as exc:  # recorded, never fatal to the campaign
         rec.update(status="failed", error=f"{type(exc).__name__}: {exc}", elapsed_s=time.perf_counter() - t0)
     rec["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     write_json_atomic(record_path(run_dir, spec.run_id), rec)
     return rec
+
+
+def dataset_layout(ds) -> dict:
+    """path -> [shape, dtype str] of the file's numeric datasets, in file order: the campaign index stacks the runs
+    from the records, so the client does not walk every run file after the last run (0.2 s for 12 runs)."""
+    return {path: [list(arr.shape), arr.dtype.str] for path, arr in ds.datasets() if arr.dtype.kind != "O"}
 
 
 def failed_record(spec: RunSpec, error: BaseException) -> dict:
