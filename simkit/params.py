@@ -99,6 +99,10 @@ SCHEMA: dict[str, Param] = {
                            optional=True),
     "cov_dt_s": Param(float, "interval of the stored covariance (s)", POS),
     "pos_sigma_scale": Param(float, "scale of the GNSS position covariance", POS),
+    "gnss_error_sigma_m": Param(float, "sigma E, N, U of the GNSS fixes' slowly varying error, estimated as three "
+                                "Gauss-Markov states (m; 0 0 0: none); default: 1.5 1.5 3 with gnss=spp, none "
+                                "with gnss=truth and in hinf", _list_check(NONNEG), shape=3, optional=True),
+    "gnss_error_tau_s": Param(float, "correlation time of that error (s)", POS),
     "alpha": Param(float, "H-infinity bound factor (Wu 2015 uses 10)", lambda v: None if v > 1 else
                    "expected > 1 (Wu 2015 uses 10)"),
     "gamma_rule": Param(str, "H-infinity gamma rule", choices=("wu", "weighted")),

@@ -3,9 +3,9 @@
 Each has ``run(imu, gnss, attitude=None) -> Solution`` on numpy arrays (``ImuData``, ``GnssFixes``,
 ``AttitudeFixes``), no file involved. The solution has one epoch per GNSS fix used (after its update): IMU-centre
 position, velocity, attitude, the error-state covariance (``cov``, in the order of ``state_names``, SI units:
-rad, m/s, rad, rad, m, rad/s, m/s^2, m), and extras: ``gyro_bias`` (rad/s), ``accel_bias`` (m/s^2),
-``lever_arm`` (m), ``nis`` with ``nis_dof`` (6; 0 where the update was skipped: the referee's NIS test) and
-``innovation_std`` (standardised position/velocity innovations), ``status``,
+rad, m/s, rad, rad, m, rad/s, m/s^2, m, and m for the optional GNSS-error states), and extras: ``gyro_bias``
+(rad/s), ``accel_bias`` (m/s^2), ``lever_arm`` (m), ``gnss_error`` (m ENU, with those states), ``nis`` with
+``nis_dof`` (6; 0 where the update was skipped: the referee's NIS test) and ``innovation_std`` (standardised position/velocity innovations), ``status``,
 and for H-infinity ``gamma`` and ``existence_margin`` (smallest eigenvalue of the existence matrix in the
 congruent form L^T (P^-1 - theta I + H^T R^-1 H) L, P = L L^T: dimensionless, positive whenever it exists).
 """
@@ -27,6 +27,7 @@ from .inputs import AttitudeFixes, DDCarrier, GnssFixes, ImuData, InitialState
 STATE_NAMES = ("phi_e", "phi_n", "phi_u", "dv_e", "dv_n", "dv_u", "d_lat", "d_lon", "d_h",
                "gyro_bias_x", "gyro_bias_y", "gyro_bias_z", "accel_bias_x", "accel_bias_y", "accel_bias_z",
                "lever_x", "lever_y", "lever_z")
+GNSS_ERROR_STATES = ("gnss_error_e", "gnss_error_n", "gnss_error_u")
 
 
 @dataclass(frozen=True)
@@ -42,7 +43,11 @@ class FilterConfig:
     ``gyro_bias0``/``accel_bias0`` initial bias estimates (body); ``dd_gate_p`` (kf15_dd) rejects a DD carrier
     epoch whose NIS exceeds the chi-square(m rows) quantile 1 - dd_gate_p (0: no gate); ``update_at_start``: use
     the measurements that fall on the initial epoch (False when the initial state was built from them, as the
-    "static", "motion" and "attitude" alignments of ``simkit solve`` do: they would count twice)."""
+    "static", "motion" and "attitude" alignments of ``simkit solve`` do: they would count twice);
+    ``gnss_error_sigma`` [E, N, U] m and ``gnss_error_tau`` s: the slowly varying error of the position fixes
+    (broadcast orbits and clocks, ionosphere and troposphere residuals, seen through the geometry) as three
+    first-order Gauss-Markov states appended to the error state (``gnss_error_e/n/u``; all sigmas 0: none). A
+    filter that takes such fixes as white noise averages them down and reports a covariance far below its error."""
 
     gyro_arw: float = 1e-4
     accel_vrw: float = 1e-3
@@ -62,26 +67,43 @@ class FilterConfig:
     gamma_rule: str = "wu"
     dd_gate_p: float = 0.0
     update_at_start: bool = True
+    gnss_error_sigma: tuple = (0.0, 0.0, 0.0)
+    gnss_error_tau: float = 1800.0
 
 
-def _p0(cfg: FilterConfig, n: int, lat: float, h: float) -> np.ndarray:
+def _layout(base: int, cfg: FilterConfig) -> tuple[int, int, int]:
+    """(state count, lever-arm index, GNSS-error index) of a filter with ``base`` states (15, or 18 with the lever
+    arm) and ``cfg``'s optional GNSS-error states; -1 for an absent block."""
+    sigma = np.broadcast_to(np.asarray(cfg.gnss_error_sigma, float), 3)
+    if not (np.all(sigma >= 0) and np.isfinite(sigma).all()) or not cfg.gnss_error_tau > 0:
+        raise EstimatorInputError(f"gnss_error_sigma {cfg.gnss_error_sigma!r} / gnss_error_tau "
+                                  f"{cfg.gnss_error_tau!r}: expected sigmas >= 0 and a correlation time > 0")
+    ib = base if np.any(sigma > 0) else -1
+    return base + (3 if ib >= 0 else 0), (15 if base >= 18 else -1), ib
+
+
+def _p0(cfg: FilterConfig, n: int, lat: float, h: float, il: int, ib: int) -> np.ndarray:
     tp = model.enu_to_geodetic(lat, h)
     sig = np.zeros(n)
     sig[0:3] = np.broadcast_to(cfg.p0_att, 3)
     sig[3:6] = cfg.p0_vel
     sig[9:12] = cfg.p0_gyro_bias
     sig[12:15] = cfg.p0_accel_bias
-    if n > 15:
-        sig[15:18] = cfg.p0_lever
+    if il >= 0:
+        sig[il:il + 3] = cfg.p0_lever
+    if ib >= 0:
+        sig[ib:ib + 3] = np.broadcast_to(cfg.gnss_error_sigma, 3)
     p = np.diag(sig**2)
     p[6:9, 6:9] = tp @ np.diag(np.broadcast_to(cfg.p0_pos, 3) ** 2.0) @ tp.T
     return p
 
 
-def _qc(cfg: FilterConfig, n: int) -> np.ndarray:
+def _qc(cfg: FilterConfig, n: int, ib: int) -> np.ndarray:
     q = np.zeros(n)
     q[0:3], q[3:6] = cfg.gyro_arw**2, cfg.accel_vrw**2
     q[9:12], q[12:15] = cfg.gyro_bias_rw**2, cfg.accel_bias_rw**2
+    if ib >= 0:  # stationary Gauss-Markov: PSD 2 sigma^2 / tau keeps the variance at sigma^2
+        q[ib:ib + 3] = 2.0 * np.broadcast_to(np.asarray(cfg.gnss_error_sigma, float), 3) ** 2 / cfg.gnss_error_tau
     return q
 
 
@@ -170,21 +192,24 @@ class _LooselyCoupled:
         if k0 > 0:  # start at the initial state's epoch (row k0 of increments covers the interval before it)
             imu = ImuData(imu.t[k0:], imu.gyro[k0:], imu.accel[k0:], imu.increments)
         comp = (from_increments if imu.increments else from_rates)(imu.t, imu.gyro, imu.accel)
-        cfg, n = self.config, self.n_states
+        cfg = self.config
+        n, il, ib = _layout(self.n_states, cfg)
         pos0 = np.asarray(init.pos_lla, float)
         nav0 = loop.Nav(Rotation.from_quat(init.quat_nb).as_matrix(), np.asarray(init.vel_enu, float), pos0,
-                        np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy())
+                        np.asarray(cfg.gyro_bias0, float), np.asarray(cfg.accel_bias0, float), gnss.lever_arm_b.copy(),
+                        np.zeros(3))
         first = 0 if cfg.update_at_start else 1  # sample 0 is the initial epoch
         idx, garr = _gnss_arrays(gnss, imu.t, first)
-        aarr = _att_arrays(attitude if n > 15 else None, imu.t, first)
+        aarr = _att_arrays(attitude if il >= 0 else None, imu.t, first)
         darr = _dd_arrays(dd if self.uses_dd else None, imu.t, float(cfg.dd_gate_p), first)
         out = loop.allocate(idx.size, n, aarr.k.size, darr.k.size)
         w_mean = window_mean_rate(comp, int(round(cfg.lever_rate_window_s / float(np.median(comp.dt)))))
         mode = self._mode()
-        tuning = loop.Tuning(_p0(cfg, n, pos0[0], pos0[2]), _qc(cfg, n), float(cfg.cov_dt), mode, float(cfg.alpha))
+        tuning = loop.Tuning(_p0(cfg, n, pos0[0], pos0[2], il, ib), _qc(cfg, n, ib), float(cfg.cov_dt), mode,
+                             float(cfg.alpha), il, ib, float(cfg.gnss_error_tau))
         loop.run(loop.Samples(comp.phi, comp.dvb, comp.dt, comp.w_ib, w_mean), nav0, tuning, garr, aarr, darr, out,
                  None if mode == 0 else True)
-        sol = self._solution(imu.t[garr.k], out)
+        sol = self._solution(imu.t[garr.k], out, ib >= 0)
         return _with_dd(sol, garr.k, darr, out.dd_nis) if self.uses_dd else sol
 
     def _mode(self) -> int:
@@ -194,8 +219,8 @@ class _LooselyCoupled:
             raise EstimatorInputError(f"gamma_rule: expected 'wu' or 'weighted', got {self.config.gamma_rule!r}")
         return 1 if self.config.gamma_rule == "wu" else 2
 
-    def _solution(self, t, out) -> Solution:
-        c, v, pos, cov, bias, lever, gamma, margin, nis, w, status, att_nis, _ = out
+    def _solution(self, t, out, gnss_error: bool) -> Solution:
+        c, v, pos, cov, bias, lever, gamma, margin, nis, w, status, att_nis, _, gnss_err = out
         rot = Rotation.from_matrix(c)
         extras = {"gyro_bias": bias[:, :3], "accel_bias": bias[:, 3:], "lever_arm": lever, "nis": nis,
                   "nis_dof": np.where(np.isfinite(nis), w.shape[1], 0).astype(np.int32),
@@ -206,6 +231,9 @@ class _LooselyCoupled:
                  "innovation_std": "1",
                  "status": "0 ok, 1 gamma raised to the weighted rule (Wu's rule would violate the existence "
                            "condition or leave a margin below 1 - 1/alpha), 2 S not positive definite (update skipped)"}
+        if gnss_error:
+            extras["gnss_error"] = gnss_err
+            units["gnss_error"] = "m (ENU: the estimated slowly varying error of the GNSS position fixes)"
         if self.mode == 1:
             extras.update(gamma=gamma, existence_margin=margin)
             units.update(gamma="1", existence_margin="1 (smallest eigenvalue of L^T (P^-1 - theta I + H^T R^-1 H) L, "
@@ -215,7 +243,8 @@ class _LooselyCoupled:
             config["attitude_nis_mean"] = float(np.nanmean(att_nis))
         return Solution(t=t, pos_ecef=lla_to_ecef(pos[:, 0], pos[:, 1], pos[:, 2]), vel_enu=v,
                         quat_nb=rot.as_quat(), euler=euler_from_attitude(rot), cov=cov,
-                        state_names=STATE_NAMES[:self.n_states], extras=extras, extra_units=units, config=config)
+                        state_names=STATE_NAMES[:self.n_states] + (GNSS_ERROR_STATES if gnss_error else ()),
+                        extras=extras, extra_units=units, config=config)
 
 
 class KalmanFilter15(_LooselyCoupled):

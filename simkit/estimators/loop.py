@@ -20,7 +20,8 @@ from . import kalman, model, nav
 
 class Nav(NamedTuple):
     """The navigation state: ``c`` C_b^n (3, 3) body -> ENU, ``v`` (3,) m/s ENU, ``pos`` (3,) [lat rad, lon rad,
-    h m], ``bg`` (3,) rad/s gyro and ``ba`` (3,) m/s^2 accelerometer biases, ``lever`` (3,) m body frame."""
+    h m], ``bg`` (3,) rad/s gyro and ``ba`` (3,) m/s^2 accelerometer biases, ``lever`` (3,) m body frame, ``gb``
+    (3,) m ENU the estimate of the GNSS position fixes' slowly varying error (zero without its states)."""
 
     c: np.ndarray
     v: np.ndarray
@@ -28,6 +29,7 @@ class Nav(NamedTuple):
     bg: np.ndarray
     ba: np.ndarray
     lever: np.ndarray
+    gb: np.ndarray
 
 
 class Samples(NamedTuple):
@@ -43,13 +45,18 @@ class Samples(NamedTuple):
 
 class Tuning(NamedTuple):
     """``p0`` (n, n) initial covariance, ``qc`` (n,) white-noise densities, ``cov_dt`` s covariance step, ``mode``
-    (0 Kalman, 1 H-infinity Wu's gamma, 2 weighted gamma), ``alpha`` the H-infinity alpha."""
+    (0 Kalman, 1 H-infinity Wu's gamma, 2 weighted gamma), ``alpha`` the H-infinity alpha; the layout of the
+    optional states: ``il`` index of the lever-arm states, ``ib`` of the GNSS position-error states (-1: none),
+    ``bias_tau`` s the correlation time of the latter (first-order Gauss-Markov)."""
 
     p0: np.ndarray
     qc: np.ndarray
     cov_dt: float
     mode: int
     alpha: float
+    il: int
+    ib: int
+    bias_tau: float
 
 
 class Fixes(NamedTuple):
@@ -93,18 +100,35 @@ class Outputs(NamedTuple):
     status: np.ndarray
     att_nis: np.ndarray
     dd_nis: np.ndarray
+    gnss_error: np.ndarray
 
 
 @njit(cache=True)
-def _feedback(x, c, v, pos, bg, ba, lever):
-    c = nav.orthonormalise(nav.rotvec_matrix(x[0:3]) @ c)
-    v = v - x[3:6]
-    pos = pos - x[6:9]
-    bg = bg + x[9:12]
-    ba = ba + x[12:15]
-    if x.size >= 18:
-        lever = lever - x[15:18]
-    return c, v, pos, bg, ba, lever
+def _feedback(x, st, il, ib):
+    """The navigation state ``st`` (:class:`Nav`) corrected by the error state ``x`` (closed loop); ``il``,
+    ``ib`` the lever-arm and GNSS-error state indices (-1: none)."""
+    lever, gb = st.lever, st.gb
+    if il >= 0:
+        lever = lever - x[il:il + 3]
+    if ib >= 0:
+        gb = gb - x[ib:ib + 3]
+    return Nav(nav.orthonormalise(nav.rotvec_matrix(x[0:3]) @ st.c), st.v - x[3:6], st.pos - x[6:9],
+               st.bg + x[9:12], st.ba + x[12:15], lever, gb)
+
+
+@njit(cache=True)
+def _propagate(p, st, fn, tacc, qc, ib, bias_tau):
+    """(P, GNSS-error estimate) after ``tacc`` s from the state ``st`` (:class:`Nav`) at the mean specific force
+    ``fn`` (ENU, m/s^2): the GNSS-error states (``ib``; -1 none) are first-order Gauss-Markov with correlation time
+    ``bias_tau`` s, and their estimate decays as the error's mean does."""
+    f = model.system_matrix(st.c, st.v, st.pos, fn, p.shape[0])
+    gb = st.gb
+    if ib >= 0:
+        for i in range(3):
+            f[ib + i, ib + i] = -1.0 / bias_tau
+        gb = gb * np.exp(-tacc / bias_tau)
+    phim, qd = model.discretise(f, qc, tacc)
+    return phim @ p @ phim.T + qd, gb
 
 
 @njit(cache=True)
@@ -122,15 +146,22 @@ def _hinf(p, nu, h, r, alpha, weighted):
 
 
 @njit(cache=True)
-def _pv_rows(c, v, pos, lever, w_ib, w_mean, z, n):
+def _pv_rows(st, w_ib, w_mean, z, n, il, ib):
     """Innovation (INS minus GNSS) and H of a position/velocity fix at the antenna: the prediction from the body
     rate ``w_ib`` at the fix's sample, the lever-arm velocity rows (21 states) from the window mean ``w_mean``.
     Why: the gyro noise n of w_ib is in the innovation as C (n x l); an H row C [(w + n) x] built from the same n
     correlates with it, E[H^T nu] = E[[n x]^T [n x]] l != 0, and the estimate of l is pulled towards zero
-    (errors-in-variables regression dilution; with w ~ 0, in straight flight, all the way)."""
-    pred, h = model.antenna_rows(c, v, pos, lever, w_ib, n)
-    if n >= 18:
-        h[3:6, 15:18] = c @ nav.skew(model.body_rate_nb(c, v, pos, w_mean))
+    (errors-in-variables regression dilution; with w ~ 0, in straight flight, all the way).
+    The fixes' slowly varying error ``st.gb`` (ENU m; states ``ib``) adds to the predicted position: z = p + T_p b.
+    ``st`` the navigation state (:class:`Nav`), ``il`` the lever-arm states (-1: none)."""
+    c, v, pos, gb = st.c, st.v, st.pos, st.gb
+    pred, h = model.antenna_rows(c, v, pos, st.lever, w_ib, n, il)
+    if il >= 0:
+        h[3:6, il:il + 3] = c @ nav.skew(model.body_rate_nb(c, v, pos, w_mean))
+    if ib >= 0:
+        tp = model.enu_to_geodetic(pos[0], pos[2])
+        pred[0:3] += tp @ gb
+        h[0:3, ib:ib + 3] = tp
     nu = pred - z
     nu[1] = model.wrap(nu[1])
     return nu, h
@@ -160,7 +191,7 @@ def _dd_rows(c, dd, i, n):
 def _record(out, j, nav, p, res):
     """Store the state ``nav`` (:class:`Nav`), covariance ``p`` and correction ``res`` of fix ``j`` in ``out``."""
     out.c[j], out.v[j], out.pos[j], out.cov[j] = nav.c, nav.v, nav.pos, p
-    out.bias[j, 0:3], out.bias[j, 3:6], out.lever[j] = nav.bg, nav.ba, nav.lever
+    out.bias[j, 0:3], out.bias[j, 3:6], out.lever[j], out.gnss_error[j] = nav.bg, nav.ba, nav.lever, nav.gb
     out.nis[j], out.w[j], out.gamma[j], out.margin[j], out.status[j] = res[2], res[3], res[4], res[5], res[6]
 
 
@@ -169,7 +200,7 @@ def allocate(m, n, k_att, k_dd) -> Outputs:
     return Outputs(np.full((m, 3, 3), np.nan), np.full((m, 3), np.nan), np.full((m, 3), np.nan),
                    np.full((m, n, n), np.nan), np.full((m, 6), np.nan), np.full((m, 3), np.nan), np.full(m, np.nan),
                    np.full(m, np.nan), np.full(m, np.nan), np.full((m, 6), np.nan), np.full(m, -1, dtype=np.int64),
-                   np.full(k_att, np.nan), np.full(k_dd, np.nan))
+                   np.full(k_att, np.nan), np.full(k_dd, np.nan), np.full((m, 3), np.nan))
 
 
 @njit(cache=True)
@@ -180,8 +211,8 @@ def run(imu, nav0, tuning, gnss, att, dd, out, hinf):
     (:class:`Fixes`) and the fixed DD carrier ``dd`` (:class:`DDRows`). Fills and returns ``out``
     (:class:`Outputs`). ``hinf``: None (Kalman) or True (H-infinity, ``tuning.mode`` 1 or 2): see the module doc."""
     phi, dvb, dt, w_ib, w_mean = imu
-    c, v, pos, bg, ba, lever = nav0
-    p, qc, cov_dt, mode, alpha = tuning
+    c, v, pos, bg, ba, lever, gb = nav0
+    p, qc, cov_dt, mode, alpha, il, ib, bias_tau = tuning
     gk, gz, gr = gnss
     ak, az, ar = att
     dk = dd.k
@@ -200,8 +231,7 @@ def run(imu, nav0, tuning, gnss, att, dd, out, hinf):
         a_due = ia < ak.size and ak[ia] == s
         d_due = idd < dk.size and dk[idd] == s
         if tacc > 0.0 and (tacc >= cov_dt - 1e-9 or g_due or a_due or d_due):
-            phim, qd = model.discretise(model.system_matrix(c, v, pos, fsum / tacc, p.shape[0]), qc, tacc)
-            p = phim @ p @ phim.T + qd
+            p, gb = _propagate(p, Nav(c, v, pos, bg, ba, lever, gb), fsum / tacc, tacc, qc, ib, bias_tau)
             fsum, tacc = np.zeros(3), 0.0
         elif k % 64 == 0:
             c = nav.orthonormalise(c)
@@ -214,7 +244,8 @@ def run(imu, nav0, tuning, gnss, att, dd, out, hinf):
             elif kind == 1 and d_due:
                 nu, h, r = _dd_rows(c, dd, idd, p.shape[0])
             elif kind == 2 and g_due:
-                nu, h = _pv_rows(c, v, pos, lever, w_ib[s] - bg, w_mean[s] - bg, gz[ig], p.shape[0])
+                nu, h = _pv_rows(Nav(c, v, pos, bg, ba, lever, gb), w_ib[s] - bg, w_mean[s] - bg, gz[ig], p.shape[0],
+                                 il, ib)
                 r = gr[ig]
             else:
                 continue
@@ -222,7 +253,7 @@ def run(imu, nav0, tuning, gnss, att, dd, out, hinf):
             gated = kind == 1 and not res[2] <= dd.gate[idd]  # DD innovation gate (inf: off): state kept
             if not gated:
                 p = res[1]
-                c, v, pos, bg, ba, lever = _feedback(res[0], c, v, pos, bg, ba, lever)
+                c, v, pos, bg, ba, lever, gb = _feedback(res[0], Nav(c, v, pos, bg, ba, lever, gb), il, ib)
             if kind == 0:
                 out.att_nis[ia] = res[2]
                 ia += 1
@@ -230,6 +261,6 @@ def run(imu, nav0, tuning, gnss, att, dd, out, hinf):
                 out.dd_nis[idd] = res[2]
                 idd += 1
             else:
-                _record(out, ig, Nav(c, v, pos, bg, ba, lever), p, res)
+                _record(out, ig, Nav(c, v, pos, bg, ba, lever, gb), p, res)
                 ig += 1
     return out

@@ -3,7 +3,8 @@
 Error state (15 or 21), SI units:
     x = [phi_E, phi_N, phi_U (rad), dv_E, dv_N, dv_U (m/s), dL, dlambda (rad), dh (m),
          eps_x, eps_y, eps_z (rad/s, gyro drift, body), nabla_x, nabla_y, nabla_z (m/s^2, accel bias, body),
-         (dl_x, dl_y, dl_z (m), lever-arm error, body: 21 states only)]
+         (dl_x, dl_y, dl_z (m), lever-arm error, body: 21 states only),
+         (db_E, db_N, db_U (m), error of the estimated GNSS position-fix error, ENU: when configured)]
 Definitions (computed minus true): C~_b^n = (I - [phi x]) C_b^n, dv = v~ - v, dp = p~ - p, eps and nabla are the
 sensor errors left after compensation (measured = true + error), dl = l~ - l. Then (psi-free "phi-angle" form):
     phi'  = -w_in^n x phi + dw_in^n - C_b^n eps
@@ -11,12 +12,13 @@ sensor errors left after compensation (measured = true + error), dl = l~ - l. Th
     dL'   = dv_N/(R_M+h) - v_N dh/(R_M+h)^2
     dlam' = dv_E sec L/(R_N+h) + v_E sec L tan L dL/(R_N+h) - v_E sec L dh/(R_N+h)^2
     dh'   = dv_U;   eps' = w_g,  nabla' = w_a  (random walks; random constants when their PSD is 0),
+    db'   = -db / tau + w_b  (first-order Gauss-Markov: the fixes' error from orbits, clocks and atmosphere),
 the equations of Wu 2015 eqs 5-8 with the sign of the drift terms made explicit, plus the gravity-height term
 dg_U = 2 gamma / R dh. Discretisation is second order: Phi = I + F T + (F T)^2 / 2, Q_d = (Phi Q_c Phi^T + Q_c) T/2,
 with F frozen over the covariance interval T (default 0.1 s).
 
 Measurements (loosely coupled, Badshah 2015 eqs 46-52): antenna position [L, lambda, h] and ENU velocity, INS
-minus GNSS, with the lever arm l^b:  p_ant = p + T_p C l,   v_ant = v + C (w_nb^b x l),
+minus GNSS, with the lever arm l^b:  p_ant = p + T_p C l (+ T_p b, the fixes' error),   v_ant = v + C (w_nb^b x l),
 where T_p maps ENU metres to [dL, dlambda, dh]; and the GNSS attitude [pitch, roll, heading], INS minus GNSS,
 with its Jacobian with respect to phi evaluated numerically (the Euler-rate matrix of eq 43).
 """
@@ -133,9 +135,9 @@ def body_rate_nb(c, v, pos, w_ib_b):
 
 
 @njit(cache=True)
-def antenna_rows(c, v, pos, lever, w_ib_b, n):
+def antenna_rows(c, v, pos, lever, w_ib_b, n, il=-1):
     """Predicted antenna [L, lambda, h, v_E, v_N, v_U] and H (6, n) for lever arm ``lever`` (body, m) and body
-    rate ``w_ib_b`` (rad/s)."""
+    rate ``w_ib_b`` (rad/s); ``il`` the index of the lever-arm error states (-1: not estimated)."""
     w_nb = body_rate_nb(c, v, pos, w_ib_b)
     tp = enu_to_geodetic(pos[0], pos[2])
     cl = c @ lever
@@ -148,9 +150,9 @@ def antenna_rows(c, v, pos, lever, w_ib_b, n):
     h[0:3, 6:9] = np.eye(3)
     h[3:6, 0:3] = nav.skew(cwl)
     h[3:6, 3:6] = np.eye(3)
-    if n >= 18:
-        h[0:3, 15:18] = tp @ c
-        h[3:6, 15:18] = c @ nav.skew(w_nb)
+    if il >= 0:
+        h[0:3, il:il + 3] = tp @ c
+        h[3:6, il:il + 3] = c @ nav.skew(w_nb)
     return pred, h
 
 

@@ -24,7 +24,7 @@ COMMON = {"gnss": "spp", "antenna": 0, "elevation_mask_deg": 10.0, "sigma_code_m
 FILTER = {"align": "auto", "align_static_s": 10.0, "init_heading_error_deg": 0.0, "p0_att_deg": [1.0, 1.0, 10.0],
           "p0_vel_m_per_s": 0.5, "p0_pos_m": [5.0, 5.0, 10.0], "gyro_arw": None, "accel_vrw": None,
           "gyro_bias_rw": None, "accel_bias_rw": None, "p0_gyro_bias": None, "p0_accel_bias": None,
-          "cov_dt_s": 0.1, "pos_sigma_scale": 1.0}
+          "cov_dt_s": 0.1, "pos_sigma_scale": 1.0, "gnss_error_sigma_m": None, "gnss_error_tau_s": 900.0}
 DEFAULTS = {"spp": dict(COMMON), "kf15": {**COMMON, **FILTER},
             "hinf": {**COMMON, **FILTER, "alpha": 10.0, "gamma_rule": "wu"},
             "kf21": {**COMMON, **FILTER, "use_attitude": True, "attitude_sigma_deg": 0.3, "p0_lever_m": 0.1,
