@@ -1,0 +1,285 @@
+"""Broadcast orbit/clock error (SISRE) and the zenith troposphere error of a static receiver with a known position.
+
+Residuals. Per system (GPS, BDS) the first two signals on different frequencies give the ionosphere-free code
+P_IF (the first-order ionosphere removed), in metres:
+
+    y = P_IF - GD_IF + c dT^s - rho - T_model(el) = c dt_sys(t) + b_u + dT_z m(el) + e
+
+rho the range from the reference to the broadcast satellite position at emission with the Sagnac term, dT^s the
+broadcast clock, GD_IF the combination's group delay of the navigation data (/gnss/group_delay; zero for GPS
+L1/L2, whose broadcast clock refers to that combination), T_model the receiver's Saastamoinen 1/sin(el)
+troposphere (:func:`simkit.gnss.atmosphere.troposphere`). What is left: the receiver clock of the system,
+per satellite pass (a *unit*: a contiguous pass, cut where an ephemeris interval ends) a bias b_u = the
+orbit and clock error projected on the line of sight (the SISRE's sample), the zenith delay error dT_z mapped with
+m(el), and code noise and multipath e. Where the carrier is continuous the code is levelled to it over the arc
+(carrier-smoothed: P_IF's arc mean on the carrier's shape), so e within an arc is the carrier's; the arc mean still
+carries the code noise and multipath averaged over the arc, which is accounted for below.
+
+Separation (the clock and 1/sin(el) are correlated: both are common to a system's satellites at high elevation):
+
+1. Per system, y = c(t) + b_u by least squares (alternating means, the two-way layout with missing cells); b_u is
+   known up to the system's mean, which the clock takes: the b_u are centred per system. The same linear
+   operator applied to m(el) gives each unit's mapped coefficient x_u, so that b_hat_u = b_u + dT_z x_u + noise,
+   exactly, whatever the epochs each satellite covers.
+2. dT_z from the regression of b_hat_u on x_u with one intercept per system, across the satellites of both
+   systems: the clock never enters it (centred out at every epoch), and a pass's bias is decorrelated from
+   its elevation because it is random over satellites (zero mean). Its uncertainty is the regression's.
+3. The SISRE per system is the spread of the regression residuals (degrees of freedom: units minus the system's
+   intercept minus its share of dT_z) less the noise of each unit's arc mean (its code-minus-carrier scatter over
+   the arc, inflated for the lag-one correlation of multipath: var(mean) = s^2 / n (1 + rho) / (1 - rho)); its
+   uncertainty the chi-square sampling of a standard deviation, sigma / sqrt(2 dof).
+
+The troposphere: two hypotheses are fitted, the truth mapped like the receiver's model (1/sin(el): ``"model"``)
+or with the Niell (1996) functions (``"niell"``: the model's zenith delays mapped with Niell removed first, then
+dT_z with the Niell functions); the one with the smaller residual sum of squares is the fitted ``tropo_mapping``
+(the difference is metres below 10 deg elevation, so a file with low satellites decides it). A constant
+zenith offset dT_z is one draw of the truth's dZHD + dZWD, not their sigma: the fragment writes
+tropo_zhd_sigma_m and tropo_zwd_sigma_m only when |dT_z| exceeds twice its uncertainty (then split in the
+defaults' proportion, their root sum of squares = |dT_z|), and the random walk is not identifiable from a file
+of minutes (kept at the default). The SISRE scales the system's orbit and clock sigmas together by
+SISRE_fit / SISRE_default (one station cannot separate orbit from clock), with the global-average weights of
+Montenbruck et al. (2018): w_R = 0.98, w_A,C^2 = 1/49 (GPS) and 0.98, 1/54 (BDS MEO).
+
+Limits: the broadcast group delays are good to a few decimetres; C1C's differential code bias to P1 (decimetres)
+is not removed and lands in the SISRE; BDS GEO/IGSO passes get the MEO weights; a receiver antenna's phase
+centre variation (millimetres to centimetres) goes into dT_z and the SISRE.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import gpstime
+from ..earth import C_LIGHT, OMEGA_E
+from ..gnss import atmosphere
+from ..gnss.tropo_truth import niell_mapping
+from ..gnss.truth_config import realistic_defaults
+from . import fidelity
+from .ionosphere import _level, _pair
+
+SYSTEMS = {"G": "gps", "C": "bds"}
+SISRE_WEIGHTS = {"G": (0.98, 1.0 / 49.0), "C": (0.98, 1.0 / 54.0)}   # (w_R, w_AC^2), Montenbruck et al. 2018
+INTERVAL_S = {"G": 7200.0, "C": 3600.0}    # a pass is cut where the system's ephemeris interval ends
+MIN_UNITS = 4
+MIN_EPOCHS = 3
+
+
+def sisre_of(orbit_sigma_rac_m, clock_sigma_m, system: str) -> float:
+    """Global-average SISRE (m) of independent orbit (R, A, C) and clock errors of RMS ``orbit_sigma_rac_m`` (3,)
+    m and ``clock_sigma_m`` m: sqrt((w_R sigma_R)^2 + sigma_clk^2 + w_AC^2 (sigma_A^2 + sigma_C^2))."""
+    w_r, w_ac = SISRE_WEIGHTS[system]
+    r, a, c = orbit_sigma_rac_m
+    return float(np.sqrt((w_r * r) ** 2 + clock_sigma_m ** 2 + w_ac * (a ** 2 + c ** 2)))
+
+
+def residuals(real: dict, reference, elevation_cut_deg: float = 5.0) -> dict:
+    """Ionosphere-free code residuals of ``real`` (the dict of :func:`.twin.real_arrays`, with ``sat_clock``
+    (M, S) s and ``group_delay`` (S, G) m) at the static ``reference`` (3,) m ECEF, for the GPS and BDS satellites
+    above ``elevation_cut_deg``: {y (M, S) m (NaN where none), noise_var (M, S) m^2 of the arc mean the epoch belongs
+    to, unit (M, S) int (-1 none), el (M, S) rad, system (S,), lat, h, doy, pairs {system: [sig, sig]}}."""
+    import pymap3d
+
+    signals, freq, t = real["signals"], np.asarray(real["freq"], float), real["t"]
+    ref = np.asarray(reference, float)
+    sat = real["sat_pos"]
+    rx = np.broadcast_to(ref, (t.size, 3))
+    el = fidelity.elevations(sat, ref)
+    lat, lon, h = pymap3d.ecef2geodetic(*ref, deg=False)
+    rho = np.linalg.norm(sat - rx[:, None, :], axis=-1) + OMEGA_E * (sat[..., 0] * ref[1] - sat[..., 1] * ref[0]) / C_LIGHT
+    gd = real["group_delay"] if real.get("group_delay") is not None else np.zeros((len(real["sat_id"]), len(signals)))
+    system = np.array([s[0] for s in real["sat_id"]])
+    y = np.full(el.shape, np.nan)
+    noise_var = np.full(el.shape, np.nan)
+    pairs = {}
+    obs = real["obs"]
+    for letter in SYSTEMS:
+        pair = _pair(signals, freq, letter)
+        cols = system == letter
+        if pair is None or not cols.any():
+            continue
+        i, j = pair
+        fa, fb = freq[i] ** 2, freq[j] ** 2
+        p_if = (fa * obs["code"][signals[i]] - fb * obs["code"][signals[j]]) / (fa - fb)
+        gd_if = (fa * gd[:, i] - fb * gd[:, j]) / (fa - fb)
+        l_if = (fa * obs["carrier"][signals[i]] * C_LIGHT / freq[i]
+                - fb * obs["carrier"][signals[j]] * C_LIGHT / freq[j]) / (fa - fb)
+        lli = obs["lli"][signals[i]].astype(np.uint8) | obs["lli"][signals[j]].astype(np.uint8)
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(p_if) & np.isfinite(el) & (el >= np.radians(elevation_cut_deg)) & cols[None, :]
+        label = fidelity.arcs(ok & np.isfinite(l_if), lli, t, np.where(ok, p_if - l_if, np.nan))
+        levelled = _level(l_if, p_if - l_if, label)
+        code = np.where(label >= 0, levelled, p_if)
+        r = code - gd_if[None, :] + C_LIGHT * real["sat_clock"] - rho - atmosphere.troposphere(lat, h, el)
+        y[ok] = r[ok]
+        noise_var[ok] = _arc_mean_variance(p_if - l_if, label, ok)[ok]
+        pairs[letter] = [signals[i], signals[j]]
+    unit = _units(np.isfinite(y), t, real["start"], system)
+    utc = gpstime.gps_to_utc(*real["start"])
+    doy = utc.timetuple().tm_yday + (utc.hour * 3600 + utc.minute * 60 + utc.second) / 86400.0
+    return {"y": y, "noise_var": noise_var, "unit": unit, "el": el, "system": system, "lat": lat, "h": h,
+            "doy": doy, "pairs": pairs, "t": t, "sat_id": list(real["sat_id"])}
+
+
+def _arc_mean_variance(mp, label, ok) -> np.ndarray:
+    """Per epoch, the variance (m^2) of the mean of the code-minus-carrier ``mp`` over its arc: s^2 / n inflated by
+    (1 + rho) / (1 - rho) for the pooled lag-one correlation rho; epochs outside a carrier arc (code alone) get
+    the pooled scatter s^2 itself (no averaging claimed)."""
+    out = np.full(mp.shape, np.nan)
+    lab = label.ravel(order="F")
+    x = mp.ravel(order="F")
+    good = lab >= 0
+    if not good.any():
+        pooled = np.nan
+        out[ok] = pooled
+        return out
+    ids, inv, n = np.unique(lab[good], return_inverse=True, return_counts=True)
+    mean = np.bincount(inv, weights=x[good]) / n
+    dev = x[good] - mean[inv]
+    ss = np.bincount(inv, weights=dev ** 2)
+    s2 = np.where(n > 1, ss / np.maximum(n - 1, 1), np.nan)
+    pooled = float(np.sum(ss) / max(np.sum(n - 1), 1))
+    s2 = np.where(np.isfinite(s2), s2, pooled)
+    d2 = dev.copy()
+    same = np.concatenate([inv[1:] == inv[:-1], [False]])
+    num = float(np.sum(d2[:-1][same[:-1]] * d2[1:][same[:-1]]))
+    rho = float(np.clip(num / np.sum(dev ** 2), 0.0, 0.95)) if np.sum(dev ** 2) > 0 else 0.0
+    var = s2 / n * (1.0 + rho) / (1.0 - rho)
+    flat = out.ravel(order="F")
+    flat[np.flatnonzero(good)] = var[inv]
+    out = flat.reshape(mp.shape, order="F")
+    out[ok & ~(label >= 0)] = pooled
+    return out
+
+
+def _units(valid, t, start, system) -> np.ndarray:
+    """Pass labels (M, S) int (-1 where not valid): a new pass at a gap of more than 1.5 intervals or where the
+    satellite's ephemeris interval (:data:`INTERVAL_S` of GPS time) changes."""
+    week, sow = gpstime.add_seconds(*start, t)
+    t_abs = np.asarray(week, float) * gpstime.SECONDS_PER_WEEK + np.asarray(sow, float)
+    period = np.array([INTERVAL_S.get(s, 7200.0) for s in system])
+    block = np.floor(t_abs[:, None] / period[None, :] + 0.5)     # the nearest-toe record, as the truth model
+    m, s = valid.shape
+    dt = np.diff(t)
+    interval = float(np.median(dt)) if dt.size else 1.0
+    gap = np.concatenate([[True], dt > 1.5 * interval])
+    new_block = np.concatenate([np.ones((1, s), bool), block[1:] != block[:-1]])
+    prev = np.concatenate([np.zeros((1, s), bool), valid[:-1]])
+    start_pass = valid & (~prev | gap[:, None] | new_block)
+    label = np.cumsum(start_pass.ravel(order="F")).reshape((m, s), order="F") - 1
+    return np.where(valid, label, -1)
+
+
+def _two_way(values, unit, system, iterations: int = 500, tol: float = 1e-9):
+    """Per-unit coefficients (U,) of ``values`` (M, S) = c_sys(t) + b_u by least squares (alternating means),
+    centred per system (mean over units 0)."""
+    n_unit = int(unit.max()) + 1
+    ok = unit >= 0
+    b = np.zeros(n_unit)
+    unit_sys = np.empty(n_unit, dtype=system.dtype)
+    unit_sys[unit[ok]] = np.broadcast_to(system, unit.shape)[ok]
+    counts = np.bincount(unit[ok], minlength=n_unit)
+    for _ in range(iterations):
+        resid = np.where(ok, values - np.where(ok, b[np.maximum(unit, 0)], 0.0), np.nan)
+        clock = np.zeros(values.shape)
+        for letter in np.unique(system):
+            cols = system == letter
+            with np.errstate(invalid="ignore"):
+                c = np.nanmean(np.where(ok[:, cols], resid[:, cols], np.nan), axis=1)
+            clock[:, cols] = np.nan_to_num(c)[:, None]
+        new = np.bincount(unit[ok], weights=(values - clock)[ok], minlength=n_unit) / np.maximum(counts, 1)
+        done = np.max(np.abs(new - b)) < tol
+        b = new
+        if done:
+            break
+    for letter in np.unique(unit_sys):
+        b[unit_sys == letter] -= b[unit_sys == letter].mean()
+    return b, unit_sys, counts
+
+
+def fit(res: dict) -> dict | None:
+    """The SISRE per system and the zenith troposphere error from :func:`residuals` (module doc); None when fewer
+    than ``MIN_UNITS`` passes of ``MIN_EPOCHS`` epochs."""
+    y, el, system = res["y"], res["el"], res["system"]
+    raw = np.where(np.isfinite(y), res["unit"], -1)
+    if not (raw >= 0).any():
+        return None
+    counts = np.bincount(raw[raw >= 0])
+    keep = (raw >= 0) & (counts[np.maximum(raw, 0)] >= MIN_EPOCHS)
+    unit = np.full(y.shape, -1)
+    if keep.any():
+        unit[keep] = np.unique(raw[keep], return_inverse=True)[1]
+    n_unit = int(unit.max()) + 1
+    if n_unit < MIN_UNITS:
+        return None
+    elev = np.where(unit >= 0, el, np.pi / 2)
+    m_h, m_w = niell_mapping(res["lat"], res["h"], elev, res["doy"])
+    zh, zw = atmosphere.saastamoinen_zenith(res["lat"], res["h"])
+    hypotheses = {"model": (np.zeros(y.shape), 1.0 / np.sin(elev)),
+                  "niell": (zh * (m_h - 1.0 / np.sin(elev)) + zw * (m_w - 1.0 / np.sin(elev)), 0.5 * (m_h + m_w))}
+    ok = unit >= 0
+    noise = np.bincount(unit[ok], weights=res["noise_var"][ok], minlength=n_unit) / np.bincount(unit[ok])
+    out = {}
+    for name, (shift, mapping) in hypotheses.items():
+        b, unit_sys, n_epochs = _two_way(np.where(ok, y - shift, np.nan), unit, system)
+        x, *_ = _two_way(np.where(ok, mapping, np.nan), unit, system)
+        letters = sorted(set(unit_sys))
+        a = np.column_stack([(unit_sys == s).astype(float) for s in letters] + [x])
+        coef, *_ = np.linalg.lstsq(a, b, rcond=None)
+        r = b - a @ coef
+        dof_total = max(b.size - a.shape[1], 1)
+        s2 = float(r @ r) / dof_total
+        cov = s2 * np.linalg.pinv(a.T @ a)
+        out[name] = {"zenith_delay_error_m": float(coef[-1]), "zenith_delay_error_sigma_m": float(np.sqrt(cov[-1, -1])),
+                     "rss_m2": float(r @ r), "residual": r, "unit_sys": unit_sys}
+    best = min(out, key=lambda k: out[k]["rss_m2"])
+    r, unit_sys = out[best]["residual"], out[best]["unit_sys"]
+    systems = {}
+    n_sys = len(set(unit_sys))
+    for letter in sorted(set(unit_sys)):
+        sel = unit_sys == letter
+        n = int(sel.sum())
+        dof = n - 1 - 1.0 / n_sys * 1.0     # its intercept and its share of dT_z
+        if dof < 1:
+            continue
+        total = float(np.sum(r[sel] ** 2) / dof)
+        nv = float(np.mean(noise[sel])) if np.isfinite(noise[sel]).all() else 0.0
+        sig = float(np.sqrt(max(total - nv, 0.0)))
+        # sampling of a standard deviation from dof residuals (chi-square), the noise share removed
+        unc = float(np.sqrt(total / (2.0 * dof)) * np.sqrt(total) / max(sig, 1e-3)) if sig > 0 else float(np.sqrt(total))
+        systems[letter] = {"sisre_m": sig, "sisre_sigma_m": min(unc, float(np.sqrt(total))), "passes": n,
+                           "residual_rms_m": float(np.sqrt(total)), "arc_mean_noise_m": float(np.sqrt(nv)),
+                           "signals": res["pairs"].get(letter)}
+    return {"tropo_mapping": best,
+            "hypotheses": {k: {kk: vv for kk, vv in v.items() if kk not in ("residual", "unit_sys")}
+                           for k, v in out.items()},
+            "zenith_delay_error_m": out[best]["zenith_delay_error_m"],
+            "zenith_delay_error_sigma_m": out[best]["zenith_delay_error_sigma_m"],
+            "systems": systems, "passes": n_unit, "elevation_cut_deg": None}
+
+
+def parameters(result: dict | None, span_s: float) -> tuple[dict, list]:
+    """The [gnss.truth_errors] keys the fit determines ({key: value}) and notes on the ones it leaves."""
+    d = realistic_defaults()
+    keys, notes = {}, []
+    if result is None:
+        return keys, ["too few dual-frequency GPS/BDS passes for the SISRE and troposphere fit: defaults kept"]
+    keys["tropo_mapping"] = result["tropo_mapping"]
+    dz, sz = result["zenith_delay_error_m"], result["zenith_delay_error_sigma_m"]
+    if abs(dz) > 2.0 * sz:
+        h, w = d["tropo_zhd_sigma_m"], d["tropo_zwd_sigma_m"]
+        k = abs(dz) / np.hypot(h, w)
+        keys["tropo_zhd_sigma_m"], keys["tropo_zwd_sigma_m"] = float(min(h * k, 1.0)), float(min(w * k, 1.0))
+    else:
+        notes.append(f"zenith troposphere error {dz:+.3f} +- {sz:.3f} m: not distinguishable from 0 at 2 sigma, "
+                     "tropo_zhd_sigma_m / tropo_zwd_sigma_m kept at the defaults")
+    notes.append(f"tropo_zwd_random_walk_m_per_sqrt_h not identifiable from {span_s / 60:.0f} min of data: default kept")
+    for letter, name in SYSTEMS.items():
+        s = result["systems"].get(letter)
+        if s is None:
+            notes.append(f"{name.upper()}: no SISRE fit (too few dual-frequency passes): orbit and clock defaults kept")
+            continue
+        default = sisre_of(d[f"{name}_orbit_sigma_rac_m"], d[f"{name}_clock_sigma_m"], letter)
+        k = s["sisre_m"] / default
+        keys[f"{name}_orbit_sigma_rac_m"] = [float(v * k) for v in d[f"{name}_orbit_sigma_rac_m"]]
+        keys[f"{name}_clock_sigma_m"] = float(d[f"{name}_clock_sigma_m"] * k)
+    notes.append("the ephemeris intervals (*_ephemeris_interval_s) are not fitted: the systems' upload intervals")
+    return keys, notes
