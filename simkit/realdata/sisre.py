@@ -61,6 +61,7 @@ SISRE_WEIGHTS = {"G": (0.98, 1.0 / 49.0), "C": (0.98, 1.0 / 54.0)}   # (w_R, w_A
 INTERVAL_S = {"G": 7200.0, "C": 3600.0}    # a pass is cut where the system's ephemeris interval ends
 MIN_UNITS = 4
 MIN_EPOCHS = 3
+LIKELIHOOD_MARGIN = 4.0     # -2 log L difference that decides the mapping (about 2 sigma)
 
 
 def sisre_of(orbit_sigma_rac_m, clock_sigma_m, system: str) -> float:
@@ -105,7 +106,7 @@ def residuals(real: dict, reference, elevation_cut_deg: float = 5.0) -> dict:
         lli = obs["lli"][signals[i]].astype(np.uint8) | obs["lli"][signals[j]].astype(np.uint8)
         with np.errstate(invalid="ignore"):
             ok = np.isfinite(p_if) & np.isfinite(el) & (el >= np.radians(elevation_cut_deg)) & cols[None, :]
-        label = fidelity.arcs(ok & np.isfinite(l_if), lli, t, np.where(ok, p_if - l_if, np.nan))
+        label = fidelity.arcs(ok & np.isfinite(l_if), lli, t)   # slips: the receiver's loss-of-lock flags, gaps
         levelled = _level(l_if, p_if - l_if, label)
         code = np.where(label >= 0, levelled, p_if)
         r = code - gd_if[None, :] + C_LIGHT * real["sat_clock"] - rho - atmosphere.troposphere(lat, h, el)
@@ -219,41 +220,70 @@ def fit(res: dict) -> dict | None:
     noise = np.bincount(unit[ok], weights=res["noise_var"][ok], minlength=n_unit) / np.bincount(unit[ok])
     out = {}
     for name, (shift, mapping) in hypotheses.items():
-        b, unit_sys, n_epochs = _two_way(np.where(ok, y - shift, np.nan), unit, system)
+        b, unit_sys, _ = _two_way(np.where(ok, y - shift, np.nan), unit, system)
         x, *_ = _two_way(np.where(ok, mapping, np.nan), unit, system)
-        letters = sorted(set(unit_sys))
-        a = np.column_stack([(unit_sys == s).astype(float) for s in letters] + [x])
-        coef, *_ = np.linalg.lstsq(a, b, rcond=None)
+        out[name] = _random_bias_fit(b, x, unit_sys, noise)
+    decided = abs(out["model"]["minus2_log_l"] - out["niell"]["minus2_log_l"]) > LIKELIHOOD_MARGIN
+    best = min(out, key=lambda k: out[k]["minus2_log_l"])
+    chosen = out[best]
+    return {"tropo_mapping": best if decided else None, "tropo_mapping_preferred": best,
+            "hypotheses": {k: {kk: vv for kk, vv in v.items() if kk != "systems"} for k, v in out.items()},
+            "zenith_delay_error_m": chosen["zenith_delay_error_m"],
+            "zenith_delay_error_sigma_m": chosen["zenith_delay_error_sigma_m"],
+            "systems": {k: {**v, "signals": res["pairs"].get(k)} for k, v in chosen["systems"].items()},
+            "passes": n_unit}
+
+
+def _random_bias_fit(b, x, unit_sys, noise, iterations: int = 30) -> dict:
+    """b_u = a_sys + dT_z x_u + r_u, r_u ~ N(0, s_sys^2 + noise_u): weighted least squares for (a, dT_z) and, per
+    system, the between-pass variance s_sys^2 by the method of moments (sum r^2 / (s^2 + noise) = dof, Paule and
+    Mandel 1982), alternated; -2 log-likelihood for comparing the mapping hypotheses."""
+    letters = sorted(set(unit_sys))
+    a = np.column_stack([(unit_sys == s).astype(float) for s in letters] + [x])
+    noise = np.where(np.isfinite(noise), noise, 0.0)
+    s2 = {k: 0.25 for k in letters}
+    for _ in range(iterations):
+        var = np.array([s2[k] for k in unit_sys]) + noise
+        w = 1.0 / var
+        normal = a.T @ (w[:, None] * a)
+        coef = np.linalg.solve(normal, a.T @ (w * b))
         r = b - a @ coef
-        dof_total = max(b.size - a.shape[1], 1)
-        s2 = float(r @ r) / dof_total
-        cov = s2 * np.linalg.pinv(a.T @ a)
-        out[name] = {"zenith_delay_error_m": float(coef[-1]), "zenith_delay_error_sigma_m": float(np.sqrt(cov[-1, -1])),
-                     "rss_m2": float(r @ r), "residual": r, "unit_sys": unit_sys}
-    best = min(out, key=lambda k: out[k]["rss_m2"])
-    r, unit_sys = out[best]["residual"], out[best]["unit_sys"]
+        for k in letters:
+            sel = unit_sys == k
+            dof = sel.sum() - 1 - 1.0 / len(letters)
+            if dof >= 1:
+                s2[k] = _moment_variance(r[sel], noise[sel], dof)
+    var = np.array([s2[k] for k in unit_sys]) + noise
+    cov = np.linalg.inv(a.T @ (a / var[:, None]))
     systems = {}
-    n_sys = len(set(unit_sys))
-    for letter in sorted(set(unit_sys)):
-        sel = unit_sys == letter
-        n = int(sel.sum())
-        dof = n - 1 - 1.0 / n_sys * 1.0     # its intercept and its share of dT_z
+    for k in letters:
+        sel = unit_sys == k
+        dof = sel.sum() - 1 - 1.0 / len(letters)
         if dof < 1:
             continue
-        total = float(np.sum(r[sel] ** 2) / dof)
-        nv = float(np.mean(noise[sel])) if np.isfinite(noise[sel]).all() else 0.0
-        sig = float(np.sqrt(max(total - nv, 0.0)))
-        # sampling of a standard deviation from dof residuals (chi-square), the noise share removed
-        unc = float(np.sqrt(total / (2.0 * dof)) * np.sqrt(total) / max(sig, 1e-3)) if sig > 0 else float(np.sqrt(total))
-        systems[letter] = {"sisre_m": sig, "sisre_sigma_m": min(unc, float(np.sqrt(total))), "passes": n,
-                           "residual_rms_m": float(np.sqrt(total)), "arc_mean_noise_m": float(np.sqrt(nv)),
-                           "signals": res["pairs"].get(letter)}
-    return {"tropo_mapping": best,
-            "hypotheses": {k: {kk: vv for kk, vv in v.items() if kk not in ("residual", "unit_sys")}
-                           for k, v in out.items()},
-            "zenith_delay_error_m": out[best]["zenith_delay_error_m"],
-            "zenith_delay_error_sigma_m": out[best]["zenith_delay_error_sigma_m"],
-            "systems": systems, "passes": n_unit, "elevation_cut_deg": None}
+        sig = float(np.sqrt(s2[k]))
+        total = s2[k] + float(np.mean(noise[sel]))
+        # sampling of a variance from dof residuals (chi-square), carried to the standard deviation
+        unc = total / (max(sig, 1e-3) * np.sqrt(2.0 * dof))
+        systems[k] = {"sisre_m": sig, "sisre_sigma_m": float(min(unc, np.sqrt(total))), "passes": int(sel.sum()),
+                      "residual_rms_m": float(np.sqrt(np.mean(r[sel] ** 2))),
+                      "arc_mean_noise_m": float(np.sqrt(np.mean(noise[sel])))}
+    return {"zenith_delay_error_m": float(coef[-1]), "zenith_delay_error_sigma_m": float(np.sqrt(cov[-1, -1])),
+            "minus2_log_l": float(np.sum(np.log(var) + r ** 2 / var)), "systems": systems}
+
+
+def _moment_variance(r, noise, dof) -> float:
+    """The s^2 >= 0 with sum r^2 / (s^2 + noise) = dof (0 when even s^2 = 0 leaves the sum below dof)."""
+    def excess(s2):
+        return float(np.sum(r ** 2 / (s2 + noise + 1e-12))) - dof
+
+    if excess(0.0) <= 0:
+        return 0.0
+    lo, hi = 0.0, float(np.sum(r ** 2)) + 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if excess(mid) > 0 else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def parameters(result: dict | None, span_s: float) -> tuple[dict, list]:
@@ -262,7 +292,12 @@ def parameters(result: dict | None, span_s: float) -> tuple[dict, list]:
     keys, notes = {}, []
     if result is None:
         return keys, ["too few dual-frequency GPS/BDS passes for the SISRE and troposphere fit: defaults kept"]
-    keys["tropo_mapping"] = result["tropo_mapping"]
+    if result["tropo_mapping"] is not None:
+        keys["tropo_mapping"] = result["tropo_mapping"]
+    else:
+        notes.append(f"troposphere mapping not decided by the data (-2 log L of model / niell: "
+                     f"{result['hypotheses']['model']['minus2_log_l']:.1f} / "
+                     f"{result['hypotheses']['niell']['minus2_log_l']:.1f}): default kept")
     dz, sz = result["zenith_delay_error_m"], result["zenith_delay_error_sigma_m"]
     if abs(dz) > 2.0 * sz:
         h, w = d["tropo_zhd_sigma_m"], d["tropo_zwd_sigma_m"]

@@ -44,7 +44,7 @@ def real_arrays(imported: importer.Imported) -> dict:
             "obs": {k: {s: d[f"gnss/obs/{s}/{k}"][:, 0] for s in signals} for k in KINDS},
             "reference": d.get("reference/pos_ecef"), "start": (int(imported.attrs["start_gps_week"]),
                                                                  float(imported.attrs["start_gps_sow"])),
-            "group_delay": d.get("gnss/group_delay"),
+            "group_delay": d.get("gnss/group_delay"), "sat_clock": d.get("gnss/sat_clock"),
             "iono": {str(k): (a, b) for k, a, b in zip(d.get("gnss/iono_systems", []), d.get("gnss/iono_alpha", []),
                                                           d.get("gnss/iono_beta", []))}}
 
@@ -57,6 +57,7 @@ def file_arrays(path) -> dict:
         g = read_gnss(ds, antennas=0, obs=KINDS)
         return {"t": g.t, "sat_id": [str(s) for s in g.sat_id], "signals": list(g.signals),
                 "freq": C_LIGHT / g.wavelength_m, "sat_pos": g.sat_pos_ecef, "obs": g.obs, "reference": None,
+                "sat_clock": g.sat_clock, "group_delay": g.group_delay,
                 "start": (int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]))}
 
 
