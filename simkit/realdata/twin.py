@@ -24,7 +24,7 @@ from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
 from ..gnss.config import code_scale_at
-from . import fidelity, horizon, importer, ionosphere
+from . import fidelity, horizon, importer, ionosphere, sisre
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -106,8 +106,11 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
                                "correlation_time_s": p["mp_correlation_time_s"]},
-                 **({"truth_errors": {"iono_residual_fraction": p["iono_residual_fraction"]}}
-                    if p.get("iono_residual_fraction") is not None else {})},
+                 **({"truth_errors": {**({"iono_residual_fraction": p["iono_residual_fraction"]}
+                                         if p.get("iono_residual_fraction") is not None else {}),
+                                      **p.get("truth_errors", {})}}
+                    if p.get("iono_residual_fraction") is not None or p.get("truth_errors") else {}),
+                 **({"acquisition": dict(p["acquisition"])} if p.get("acquisition") else {})},
         **({"environment": {"reflections": False, "body_mask": [dict(p["horizon_mask"])]}}
            if p.get("horizon_mask") else {}),
     }
@@ -248,6 +251,10 @@ def fit_parameters(real: dict, reference) -> dict:
         iono = ionosphere.klobuchar_ratio(real, reference, real["group_delay"], real["iono"])
         p["_ionosphere"] = iono
         p["iono_residual_fraction"] = ionosphere.residual_fraction(iono)
+    if real.get("sat_clock") is not None and not real.get("trajectory"):   # a static station with a known position
+        p["_sisre"] = sisre.fit(sisre.residuals(real, reference))
+        p["truth_errors"], more = sisre.parameters(p["_sisre"], float(real["t"][-1] - real["t"][0]))
+        notes += more
     if p.get("iono_residual_fraction") is None:
         notes.append("no dual-frequency GPS or BDS code and carrier with a Klobuchar model: the truth "
                      "ionosphere's residual left at the default")
@@ -412,6 +419,11 @@ def toml_fragment(p: dict) -> str:
     if p.get("iono_residual_fraction") is not None:
         lines += ["", "# the real ionosphere against Klobuchar (dual-frequency geometry-free, carrier-levelled code)",
                   "[gnss.truth_errors]", f"iono_residual_fraction = {p['iono_residual_fraction']:.4f}"]
+    if p.get("truth_errors"):
+        if p.get("iono_residual_fraction") is None:
+            lines += ["", "[gnss.truth_errors]"]
+        lines += ["# broadcast orbit/clock (SISRE) and troposphere from ionosphere-free code residuals (sisre.py)"]
+        lines += [f"{k} = {_toml_value(v)}" for k, v in p["truth_errors"].items()]
     if p.get("horizon_mask"):
         tab = p["horizon_mask"]
         lines += ["", "# the station's horizon profile (a level antenna facing north: body azimuth = azimuth)",
@@ -419,6 +431,14 @@ def toml_fragment(p: dict) -> str:
                   f"azimuth_deg = [{', '.join(f'{a:g}' for a in tab['azimuth_deg'])}]",
                   f"elevation_deg = [{', '.join(f'{e:g}' for e in tab['elevation_deg'])}]"]
     return "\n".join(lines) + "\n"
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(f"{x:.4f}" for x in v) + "]"
+    return f"{v:.4f}"
 
 
 def _scale_toml(v) -> str:
@@ -464,6 +484,7 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     fitted = fit_parameters(real, ref)
     notes = fitted.pop("_notes")
     iono = fitted.pop("_ionosphere", None)
+    range_errors = fitted.pop("_sisre", None)
     hz = None
     if not real.get("trajectory"):       # a horizon profile belongs to a fixed antenna
         hz = fit_horizon(default[1], default[2], ref, mask)
@@ -472,7 +493,7 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
     tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
     fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
-    return fitted, notes, {"horizon": hz, "ionosphere": iono}
+    return fitted, notes, {"horizon": hz, "ionosphere": iono, "sisre_troposphere": range_errors}
 
 
 def _rows(arr: dict, rows) -> dict:
