@@ -318,3 +318,26 @@ def parameters(result: dict | None, span_s: float) -> tuple[dict, list]:
         keys[f"{name}_clock_sigma_m"] = float(d[f"{name}_clock_sigma_m"] * k)
     notes.append("the ephemeris intervals (*_ephemeris_interval_s) are not fitted: the systems' upload intervals")
     return keys, notes
+
+
+def report_lines(result: dict | None) -> list[str]:
+    """The report.md section of :func:`fit` (none without a fit)."""
+    if not result:
+        return []
+    out = ["", "## Broadcast orbit/clock (SISRE) and troposphere", "",
+           "Ionosphere-free code residuals at the reference, one receiver clock per system and epoch removed, the "
+           "per-pass biases against the zenith delay error (docs/real_data.md).", "",
+           "| system | signals | passes | SISRE (m) | +- (m) | residual RMS (m) | arc-mean noise (m) | default SISRE (m) |",
+           "|---|---|---:|---:|---:|---:|---:|---:|"]
+    d = realistic_defaults()
+    for letter, s in result["systems"].items():
+        name = SYSTEMS[letter]
+        default = sisre_of(d[f"{name}_orbit_sigma_rac_m"], d[f"{name}_clock_sigma_m"], letter)
+        out.append(f"| {name.upper()} | {'+'.join(s['signals'] or [])} | {s['passes']} | {s['sisre_m']:.2f} | "
+                   f"{s['sisre_sigma_m']:.2f} | {s['residual_rms_m']:.2f} | {s['arc_mean_noise_m']:.2f} | {default:.2f} |")
+    out += ["", "| mapping hypothesis | zenith delay error (m) | +- (m) | -2 log L |", "|---|---:|---:|---:|"]
+    for k, h in result["hypotheses"].items():
+        out.append(f"| {k} | {h['zenith_delay_error_m']:+.3f} | {h['zenith_delay_error_sigma_m']:.3f} | "
+                   f"{h['minus2_log_l']:.1f} |")
+    out += ["", f"Mapping decided by the data: {result['tropo_mapping'] or 'no (default kept)'}."]
+    return out

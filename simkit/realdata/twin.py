@@ -24,7 +24,7 @@ from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
 from ..gnss.config import code_scale_at
-from . import fidelity, horizon, importer, ionosphere, sisre
+from . import acquisition, fidelity, horizon, importer, ionosphere, sisre
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -424,6 +424,9 @@ def toml_fragment(p: dict) -> str:
             lines += ["", "[gnss.truth_errors]"]
         lines += ["# broadcast orbit/clock (SISRE) and troposphere from ionosphere-free code residuals (sisre.py)"]
         lines += [f"{k} = {_toml_value(v)}" for k, v in p["truth_errors"].items()]
+    if p.get("acquisition"):
+        lines += ["", "# rising satellites: first tracked this long after they cross the mask (acquisition.py)",
+                  "[gnss.acquisition]", f"delay_s = {p['acquisition']['delay_s']:.1f}"]
     if p.get("horizon_mask"):
         tab = p["horizon_mask"]
         lines += ["", "# the station's horizon profile (a level antenna facing north: body azimuth = azimuth)",
@@ -473,6 +476,19 @@ def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> d
             "holdout": horizon.holdout(el, az, real_on, twin_on, floor)}
 
 
+def fit_acquisition(real_on_grid: dict, twin: dict, reference, mask_deg: float, table=None) -> dict:
+    """The acquisition delay of rising satellites (:mod:`.acquisition`) from the real tracking on the twin's grid
+    and the default twin ``twin`` (its geometry seen from ``reference``, cut by the horizon ``table`` if any)."""
+    rx = np.broadcast_to(np.asarray(reference, float), (twin["t"].size, 3))
+    with np.errstate(invalid="ignore"):
+        el, az = angles_from_enu(lines_of_sight_enu(rx, twin["sat_pos"])[0])
+    out = acquisition.fit(twin["t"], el, az, fidelity.tracked(twin["obs"]), fidelity.tracked(real_on_grid["obs"]),
+                          mask_deg, table)
+    for r in out["rising"]:
+        r["sat"] = twin["sat_id"][r.pop("column")]
+    return out
+
+
 def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     """The fitted parameters of ``real`` (:func:`fit_parameters`, the horizon profile, then the carrier, Doppler
     and code terms scaled from a default and a first calibrated twin, and the code factors made tables over
@@ -489,11 +505,14 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     if not real.get("trajectory"):       # a horizon profile belongs to a fixed antenna
         hz = fit_horizon(default[1], default[2], ref, mask)
         fitted["horizon_mask"] = hz["table"]
+    acq = fit_acquisition(default[1], default[2], ref, mask, hz["table"] if hz else None)
+    if acq["delay_s"] > 0:
+        fitted["acquisition"] = {"delay_s": acq["delay_s"]}
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
     first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
     tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
     fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
-    return fitted, notes, {"horizon": hz, "ionosphere": iono, "sisre_troposphere": range_errors}
+    return fitted, notes, {"horizon": hz, "ionosphere": iono, "sisre_troposphere": range_errors, "acquisition": acq}
 
 
 def _rows(arr: dict, rows) -> dict:
@@ -656,6 +675,7 @@ def report_markdown(fid: dict, figures=()) -> str:
     if "fitted_parameters" in fid:
         out += ["", "## Fitted [gnss] parameters", "", "```toml", toml_fragment(fid["fitted_parameters"]).rstrip(),
                 "```"] + [f"- {n}" for n in fid.get("fit_notes", [])]
+    out += sisre.report_lines(fid.get("sisre_troposphere")) + acquisition.report_lines(fid.get("acquisition"))
     out += [""] + [f"![{Path(p).stem}]({Path(p).name})" for p in figures]
     return "\n".join(out) + "\n"
 
