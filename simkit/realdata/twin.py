@@ -518,6 +518,7 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
 def _rows(arr: dict, rows) -> dict:
     """``arr`` (a twin or real dict) cut to the epochs ``rows`` (bool (M,))."""
     return {**arr, "t": arr["t"][rows], "sat_pos": arr["sat_pos"][rows],
+            **({"sat_clock": arr["sat_clock"][rows]} if arr.get("sat_clock") is not None else {}),
             "obs": {k: {s: v[rows] for s, v in d.items()} for k, d in arr["obs"].items()}}
 
 
