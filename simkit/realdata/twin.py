@@ -164,6 +164,7 @@ def on_twin_grid(real: dict, twin: dict) -> dict:
             a[np.ix_(np.flatnonzero(keep_r), cols[keep_c])] = src
             obs[kind][sig] = a
     return {**real, "t": twin["t"], "sat_id": twin["sat_id"], "obs": obs, "sat_pos": twin["sat_pos"],
+            "sat_clock": twin.get("sat_clock"),
             "not_in_twin": [real["sat_id"][i] for i in np.flatnonzero(~keep_c)]}
 
 
