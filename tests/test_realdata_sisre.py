@@ -115,3 +115,30 @@ def test_too_few_passes_leave_the_defaults(kms3_real):
     assert sisre.fit(res) is None
     keys, notes = sisre.parameters(None, 540.0)
     assert keys == {} and "defaults kept" in notes[0]
+
+
+def test_geosynchronous_bds_satellites_get_their_scaled_sigma_and_the_same_draws():
+    from simkit.gnss.ephemeris_errors import EphemerisErrors
+    from simkit.gnss.truth_config import EphemerisErrorConfig
+
+    cfg = {"C": EphemerisErrorConfig((0.3, 1.2, 0.8), 0.9, 3600.0, geosync_scale=3.0),
+           "G": EphemerisErrorConfig((0.15, 0.6, 0.4), 0.5, 7200.0, geosync_scale=3.0)}
+    sats = ["C05", "C08", "C30", "G05"]
+    plain = EphemerisErrors(1, sats, cfg)
+    typed = EphemerisErrors(1, sats, cfg, ["GEO", "IGSO", "MEO", "MEO"])
+    week, sow = np.full(5, 2213), 331200.0 + 30.0 * np.arange(5)
+    a, _ = plain.at(week, sow, np.arange(4))
+    b, _ = typed.at(week, sow, np.arange(4))
+    np.testing.assert_allclose(b[:, :2], 3.0 * a[:, :2], rtol=1e-12)
+    np.testing.assert_array_equal(b[:, 2:], a[:, 2:])       # MEO, and GPS (the scale is BDS's key only)
+
+
+def test_the_geo_igso_scale_is_a_checked_scenario_key(tmp_path):
+    from simkit.errors import ScenarioError
+    from simkit.gnss.truth_config import parse_truth_errors
+    from simkit.section import Section
+
+    cfg = parse_truth_errors(Section({"bds_geo_igso_sigma_scale": 4.0}, "gnss.truth_errors"))
+    assert cfg.ephemeris["C"].geosync_scale == 4.0 and cfg.ephemeris["G"].geosync_scale == 1.0
+    with pytest.raises(ScenarioError, match="bds_geo_igso_sigma_scale"):
+        parse_truth_errors(Section({"bds_geo_igso_sigma_scale": -1.0}, "gnss.truth_errors"))

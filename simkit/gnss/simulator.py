@@ -130,7 +130,8 @@ class GnssSimulator:
         tropo = TruthTroposphere(seed, self.start_week, self.start_sow, self.duration_s, te.tropo_mapping,
                                  te.tropo_zhd_sigma_m, te.tropo_zwd_sigma_m, te.tropo_zwd_random_walk_m_per_sqrt_h)
         self.truth_tropo = tropo if tropo.departs else None
-        eph = EphemerisErrors(seed, self.sat_ids, te.ephemeris)
+        kinds = {sid: k for c in self.sky.constellations for sid, k in zip(c.sat_ids, c.orbit_type)}
+        eph = EphemerisErrors(seed, self.sat_ids, te.ephemeris, [kinds.get(sid, "MEO") for sid in self.sat_ids])
         self.ephemeris = eph if eph.departs else None
 
     def _group_delays(self) -> np.ndarray:

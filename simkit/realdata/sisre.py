@@ -59,8 +59,10 @@ from .ionosphere import _level, _pair
 SYSTEMS = {"G": "gps", "C": "bds"}
 SISRE_WEIGHTS = {"G": (0.98, 1.0 / 49.0), "C": (0.98, 1.0 / 54.0)}   # (w_R, w_AC^2), Montenbruck et al. 2018
 INTERVAL_S = {"G": 7200.0, "C": 3600.0}    # a pass is cut where the system's ephemeris interval ends
-MIN_UNITS = 4
+MIN_UNITS = 8
 MIN_EPOCHS = 3
+GEOSYNC_RADIUS_M = 40.0e6    # BDS GEO and IGSO orbit at 42,164 km, MEO at 27,906 km
+CLASS_NAMES = {"G": "GPS", "C": "BDS MEO", "C_geo": "BDS GEO/IGSO"}
 LIKELIHOOD_MARGIN = 4.0     # -2 log L difference that decides the mapping (about 2 sigma)
 
 
@@ -72,7 +74,7 @@ def sisre_of(orbit_sigma_rac_m, clock_sigma_m, system: str) -> float:
     return float(np.sqrt((w_r * r) ** 2 + clock_sigma_m ** 2 + w_ac * (a ** 2 + c ** 2)))
 
 
-def residuals(real: dict, reference, elevation_cut_deg: float = 5.0) -> dict:
+def residuals(real: dict, reference, elevation_cut_deg: float = 10.0) -> dict:
     """Ionosphere-free code residuals of ``real`` (the dict of :func:`.twin.real_arrays`, with ``sat_clock``
     (M, S) s and ``group_delay`` (S, G) m) at the static ``reference`` (3,) m ECEF, for the GPS and BDS satellites
     above ``elevation_cut_deg``: {y (M, S) m (NaN where none), noise_var (M, S) m^2 of the arc mean the epoch belongs
@@ -116,7 +118,10 @@ def residuals(real: dict, reference, elevation_cut_deg: float = 5.0) -> dict:
     unit = _units(np.isfinite(y), t, real["start"], system)
     utc = gpstime.gps_to_utc(*real["start"])
     doy = utc.timetuple().tm_yday + (utc.hour * 3600 + utc.minute * 60 + utc.second) / 86400.0
-    return {"y": y, "noise_var": noise_var, "unit": unit, "el": el, "system": system, "lat": lat, "h": h,
+    with np.errstate(invalid="ignore"):
+        los = (sat - rx[:, None, :]) / np.linalg.norm(sat - rx[:, None, :], axis=-1, keepdims=True)
+    return {"y": y, "noise_var": noise_var, "unit": unit, "el": el, "system": system, "lat": lat, "h": h, "los": los,
+            "sat_pos": sat,
             "doy": doy, "pairs": pairs, "t": t, "sat_id": list(real["sat_id"])}
 
 
@@ -196,9 +201,11 @@ def _two_way(values, unit, system, iterations: int = 500, tol: float = 1e-9):
     return b, unit_sys, counts
 
 
-def fit(res: dict) -> dict | None:
+def fit(res: dict, position: bool = True) -> dict | None:
     """The SISRE per system and the zenith troposphere error from :func:`residuals` (module doc); None when fewer
-    than ``MIN_UNITS`` passes of ``MIN_EPOCHS`` epochs."""
+    than ``MIN_UNITS`` passes of ``MIN_EPOCHS`` epochs. ``position``: estimate an offset of the reference (3
+    unknowns, ECEF) with them, so that a reference wrong by a metre does not pass for orbit error (the part of
+    the orbit errors that a position absorbs leaves the SISRE's degrees of freedom)."""
     y, el, system = res["y"], res["el"], res["system"]
     raw = np.where(np.isfinite(y), res["unit"], -1)
     if not (raw >= 0).any():
@@ -218,11 +225,19 @@ def fit(res: dict) -> dict | None:
                   "niell": (zh * (m_h - 1.0 / np.sin(elev)) + zw * (m_w - 1.0 / np.sin(elev)), 0.5 * (m_h + m_w))}
     ok = unit >= 0
     noise = np.bincount(unit[ok], weights=res["noise_var"][ok], minlength=n_unit) / np.bincount(unit[ok])
+    radius = np.linalg.norm(res["sat_pos"], axis=-1) if res.get("sat_pos") is not None else None
+    _, unit_sys0, _ = _two_way(np.where(ok, 0.0, np.nan), unit, system, iterations=1)
+    unit_class = unit_sys0.astype(object)
+    if radius is not None:   # BDS geosynchronous passes (GEO, IGSO): their own SISRE class
+        r_unit = np.bincount(unit[ok], weights=np.nan_to_num(radius[ok])) / np.bincount(unit[ok])
+        unit_class = np.where((unit_sys0 == "C") & (r_unit > GEOSYNC_RADIUS_M), "C_geo", unit_class)
     out = {}
     for name, (shift, mapping) in hypotheses.items():
         b, unit_sys, _ = _two_way(np.where(ok, y - shift, np.nan), unit, system)
         x, *_ = _two_way(np.where(ok, mapping, np.nan), unit, system)
-        out[name] = _random_bias_fit(b, x, unit_sys, noise)
+        pos = [(_two_way(np.where(ok, -res["los"][..., i], np.nan), unit, system)[0]) for i in range(3)] \
+            if position else []
+        out[name] = _random_bias_fit(b, x, unit_sys, noise, pos, unit_class)
     decided = abs(out["model"]["minus2_log_l"] - out["niell"]["minus2_log_l"]) > LIKELIHOOD_MARGIN
     best = min(out, key=lambda k: out[k]["minus2_log_l"])
     chosen = out[best]
@@ -230,35 +245,44 @@ def fit(res: dict) -> dict | None:
             "hypotheses": {k: {kk: vv for kk, vv in v.items() if kk != "systems"} for k, v in out.items()},
             "zenith_delay_error_m": chosen["zenith_delay_error_m"],
             "zenith_delay_error_sigma_m": chosen["zenith_delay_error_sigma_m"],
-            "systems": {k: {**v, "signals": res["pairs"].get(k)} for k, v in chosen["systems"].items()},
+            "systems": {k: {**v, "signals": res["pairs"].get(k[0])} for k, v in chosen["systems"].items()},
             "passes": n_unit}
 
 
-def _random_bias_fit(b, x, unit_sys, noise, iterations: int = 30) -> dict:
+def _random_bias_fit(b, x, unit_sys, noise, extra=(), unit_class=None, iterations: int = 30) -> dict:
     """b_u = a_sys + dT_z x_u + r_u, r_u ~ N(0, s_sys^2 + noise_u): weighted least squares for (a, dT_z) and, per
     system, the between-pass variance s_sys^2 by the method of moments (sum r^2 / (s^2 + noise) = dof, Paule and
     Mandel 1982), alternated; -2 log-likelihood for comparing the mapping hypotheses."""
     letters = sorted(set(unit_sys))
-    a = np.column_stack([(unit_sys == s).astype(float) for s in letters] + [x])
+    a = np.column_stack([(unit_sys == s).astype(float) for s in letters] + list(extra) + [x])
+    shared = len(extra) + 1          # parameters common to the systems (position, zenith delay)
     noise = np.where(np.isfinite(noise), noise, 0.0)
-    s2 = {k: 0.25 for k in letters}
+    unit_class = unit_sys if unit_class is None else np.asarray(unit_class)
+    classes = sorted(set(unit_class))
+    n_in_sys = {k: int(np.sum(unit_sys == k)) for k in letters}
+
+    def dof_of(sel):   # the class's share of its system's intercept and of the shared parameters
+        n = sel.sum()
+        return n - n / n_in_sys[unit_sys[sel][0]] - shared * n / b.size
+
+    s2 = {k: 0.25 for k in classes}
     for _ in range(iterations):
-        var = np.array([s2[k] for k in unit_sys]) + noise
+        var = np.array([s2[k] for k in unit_class]) + noise
         w = 1.0 / var
         normal = a.T @ (w[:, None] * a)
         coef = np.linalg.solve(normal, a.T @ (w * b))
         r = b - a @ coef
-        for k in letters:
-            sel = unit_sys == k
-            dof = sel.sum() - 1 - 1.0 / len(letters)
+        for k in classes:
+            sel = unit_class == k
+            dof = dof_of(sel)
             if dof >= 1:
                 s2[k] = _moment_variance(r[sel], noise[sel], dof)
-    var = np.array([s2[k] for k in unit_sys]) + noise
+    var = np.array([s2[k] for k in unit_class]) + noise
     cov = np.linalg.inv(a.T @ (a / var[:, None]))
     systems = {}
-    for k in letters:
-        sel = unit_sys == k
-        dof = sel.sum() - 1 - 1.0 / len(letters)
+    for k in classes:
+        sel = unit_class == k
+        dof = dof_of(sel)
         if dof < 1:
             continue
         sig = float(np.sqrt(s2[k]))
@@ -268,7 +292,10 @@ def _random_bias_fit(b, x, unit_sys, noise, iterations: int = 30) -> dict:
         systems[k] = {"sisre_m": sig, "sisre_sigma_m": float(min(unc, np.sqrt(total))), "passes": int(sel.sum()),
                       "residual_rms_m": float(np.sqrt(np.mean(r[sel] ** 2))),
                       "arc_mean_noise_m": float(np.sqrt(np.mean(noise[sel])))}
+    n_sys = len(letters)
     return {"zenith_delay_error_m": float(coef[-1]), "zenith_delay_error_sigma_m": float(np.sqrt(cov[-1, -1])),
+            "position_offset_ecef_m": [float(v) for v in coef[n_sys:n_sys + len(extra)]],
+            "position_offset_sigma_m": [float(np.sqrt(cov[i, i])) for i in range(n_sys, n_sys + len(extra))],
             "minus2_log_l": float(np.sum(np.log(var) + r ** 2 / var)), "systems": systems}
 
 
@@ -316,6 +343,9 @@ def parameters(result: dict | None, span_s: float) -> tuple[dict, list]:
         k = s["sisre_m"] / default
         keys[f"{name}_orbit_sigma_rac_m"] = [float(v * k) for v in d[f"{name}_orbit_sigma_rac_m"]]
         keys[f"{name}_clock_sigma_m"] = float(d[f"{name}_clock_sigma_m"] * k)
+    geo, meo = result["systems"].get("C_geo"), result["systems"].get("C")
+    if geo is not None and meo is not None and meo["sisre_m"] > 0:
+        keys["bds_geo_igso_sigma_scale"] = float(np.clip(geo["sisre_m"] / meo["sisre_m"], 0.0, 20.0))
     notes.append("the ephemeris intervals (*_ephemeris_interval_s) are not fitted: the systems' upload intervals")
     return keys, notes
 
@@ -330,10 +360,10 @@ def report_lines(result: dict | None) -> list[str]:
            "| system | signals | passes | SISRE (m) | +- (m) | residual RMS (m) | arc-mean noise (m) | default SISRE (m) |",
            "|---|---|---:|---:|---:|---:|---:|---:|"]
     d = realistic_defaults()
-    for letter, s in result["systems"].items():
-        name = SYSTEMS[letter]
-        default = sisre_of(d[f"{name}_orbit_sigma_rac_m"], d[f"{name}_clock_sigma_m"], letter)
-        out.append(f"| {name.upper()} | {'+'.join(s['signals'] or [])} | {s['passes']} | {s['sisre_m']:.2f} | "
+    for key, s in result["systems"].items():
+        name = SYSTEMS[key[0]]
+        default = sisre_of(d[f"{name}_orbit_sigma_rac_m"], d[f"{name}_clock_sigma_m"], key[0])
+        out.append(f"| {CLASS_NAMES[key]} | {'+'.join(s['signals'] or [])} | {s['passes']} | {s['sisre_m']:.2f} | "
                    f"{s['sisre_sigma_m']:.2f} | {s['residual_rms_m']:.2f} | {s['arc_mean_noise_m']:.2f} | {default:.2f} |")
     out += ["", "| mapping hypothesis | zenith delay error (m) | +- (m) | -2 log L |", "|---|---:|---:|---:|"]
     for k, h in result["hypotheses"].items():
