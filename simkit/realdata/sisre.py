@@ -369,5 +369,9 @@ def report_lines(result: dict | None) -> list[str]:
     for k, h in result["hypotheses"].items():
         out.append(f"| {k} | {h['zenith_delay_error_m']:+.3f} | {h['zenith_delay_error_sigma_m']:.3f} | "
                    f"{h['minus2_log_l']:.1f} |")
-    out += ["", f"Mapping decided by the data: {result['tropo_mapping'] or 'no (default kept)'}."]
+    chosen = result["hypotheses"][result["tropo_mapping_preferred"]]
+    out += ["", f"Mapping decided by the data: {result['tropo_mapping'] or 'no (default kept)'}. Reference offset "
+            "estimated with them (ECEF, m): " + ", ".join(f"{v:+.2f} +- {e:.2f}" for v, e in
+                                                          zip(chosen["position_offset_ecef_m"],
+                                                              chosen["position_offset_sigma_m"])) + "."]
     return out
