@@ -96,3 +96,21 @@ def test_a_simulated_rising_satellite_is_first_tracked_delay_after_the_mask(tmp_
 def test_bad_keys_are_named():
     with pytest.raises(ScenarioError, match="delay_s"):
         simkit.run(_scenario({"delay_s": -1.0}), out=None)
+
+
+def test_the_twin_fit_reads_the_delay_of_rising_satellites_in_closed_form():
+    from simkit.realdata import acquisition as fit_acq
+
+    t = np.arange(20) * 30.0
+    el = np.tile(np.radians(np.linspace(0.0, 19.0, 20))[:, None], (1, 4))
+    twin_on = _vis()[:, 0, :]                    # in view: 0 from the start, 1 at 150 s, 2 at 60 s and 360 s, 3 at 540 s
+    real_on = twin_on.copy()
+    real_on[5:7, 1] = False                      # first tracked 60 s after it came into view
+    real_on[2:4, 2] = False                      # 60 s
+    real_on[12:13, 2] = False                    # 30 s after its second rise
+    real_on[18:, 3] = False                      # never
+    r = fit_acq.fit(t, el, np.zeros_like(el), twin_on, real_on, 0.0)
+    assert [(x["column"], x["delay_s"]) for x in r["rising"]] == [(2, 60.0), (1, 60.0), (2, 30.0), (3, None)]
+    assert r["delay_s"] == 60.0 and r["used"] == 3 and r["untracked"] == 1
+    assert r["rising"][1]["elevation_deg"] == pytest.approx(7.0)
+    assert r["agreement_with"] > r["agreement_without"]

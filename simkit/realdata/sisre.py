@@ -188,9 +188,9 @@ def _two_way(values, unit, system, iterations: int = 500, tol: float = 1e-9):
         clock = np.zeros(values.shape)
         for letter in np.unique(system):
             cols = system == letter
-            with np.errstate(invalid="ignore"):
-                c = np.nanmean(np.where(ok[:, cols], resid[:, cols], np.nan), axis=1)
-            clock[:, cols] = np.nan_to_num(c)[:, None]
+            n = ok[:, cols].sum(axis=1)
+            c = np.where(ok[:, cols], resid[:, cols], 0.0).sum(axis=1) / np.maximum(n, 1)
+            clock[:, cols] = c[:, None]
         new = np.bincount(unit[ok], weights=(values - clock)[ok], minlength=n_unit) / np.maximum(counts, 1)
         done = np.max(np.abs(new - b)) < tol
         b = new
