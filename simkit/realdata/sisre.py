@@ -20,25 +20,30 @@ Separation (the clock and 1/sin(el) are correlated: both are common to a system'
 1. Per system, y = c(t) + b_u by least squares (alternating means, the two-way layout with missing cells); b_u is
    known up to the system's mean, which the clock takes: the b_u are centred per system. The same linear
    operator applied to m(el) gives each unit's mapped coefficient x_u, so that b_hat_u = b_u + dT_z x_u + noise,
-   exactly, whatever the epochs each satellite covers.
-2. dT_z from the regression of b_hat_u on x_u with one intercept per system, across the satellites of both
-   systems: the clock never enters it (centred out at every epoch), and a pass's bias is decorrelated from
-   its elevation because it is random over satellites (zero mean). Its uncertainty is the regression's.
-3. The SISRE per system is the spread of the regression residuals (degrees of freedom: units minus the system's
-   intercept minus its share of dT_z) less the noise of each unit's arc mean (its code-minus-carrier scatter over
-   the arc, inflated for the lag-one correlation of multipath: var(mean) = s^2 / n (1 + rho) / (1 - rho)); its
-   uncertainty the chi-square sampling of a standard deviation, sigma / sqrt(2 dof).
+   exactly, whatever the epochs each satellite covers (above 10 deg by default).
+2. The unit biases as random effects: b_hat_u = a_sys + dT_z x_u - e_u . dr + r_u with r_u ~ N(0, s_k^2 + n_u),
+   a_sys one intercept per clock system, e_u the unit's line of sight through the same operator and dr an offset
+   of the reference (so that a reference wrong by a metre does not pass for orbit error), s_k^2 the SISRE^2 of the
+   unit's orbit class k (GPS, BDS MEO, BDS GEO/IGSO: geosynchronous radius), n_u the noise variance of the unit's
+   arc mean (its code-minus-carrier scatter over the arc, inflated for the lag-one correlation of multipath:
+   s^2 / n (1 + rho) / (1 - rho)). Weighted least squares for (a, dr, dT_z) alternated with s_k^2 by the method
+   of moments (sum r^2 / (s_k^2 + n) = dof: the class's units less its share of the parameters; Paule and
+   Mandel 1982). The clock never enters (it is centred out at every epoch) and a pass's bias is decorrelated
+   from its elevation because it is zero-mean over the satellites: that is what separates dT_z from the clock.
+   The SISRE's uncertainty is the chi-square sampling of a variance from dof residuals, carried to the standard
+   deviation; dT_z's is the weighted regression's.
 
 The troposphere: two hypotheses are fitted, the truth mapped like the receiver's model (1/sin(el): ``"model"``)
 or with the Niell (1996) functions (``"niell"``: the model's zenith delays mapped with Niell removed first, then
-dT_z with the Niell functions); the one with the smaller residual sum of squares is the fitted ``tropo_mapping``
-(the difference is metres below 10 deg elevation, so a file with low satellites decides it). A constant
-zenith offset dT_z is one draw of the truth's dZHD + dZWD, not their sigma: the fragment writes
-tropo_zhd_sigma_m and tropo_zwd_sigma_m only when |dT_z| exceeds twice its uncertainty (then split in the
-defaults' proportion, their root sum of squares = |dT_z|), and the random walk is not identifiable from a file
-of minutes (kept at the default). The SISRE scales the system's orbit and clock sigmas together by
-SISRE_fit / SISRE_default (one station cannot separate orbit from clock), with the global-average weights of
-Montenbruck et al. (2018): w_R = 0.98, w_A,C^2 = 1/49 (GPS) and 0.98, 1/54 (BDS MEO).
+dT_z with the Niell functions); ``tropo_mapping`` is decided only when their -2 log-likelihoods differ by more
+than ``LIKELIHOOD_MARGIN`` (the difference is metres below 10 deg elevation; minutes of data with few low passes
+rarely decide it). A constant zenith offset dT_z is one draw of the truth's dZHD + dZWD, not their sigma: the
+fragment writes tropo_zhd_sigma_m and tropo_zwd_sigma_m only when |dT_z| exceeds twice its uncertainty (then split
+in the defaults' proportion, their root sum of squares = |dT_z|), and the random walk is not identifiable from a
+file of minutes (kept at the default). The SISRE scales the system's orbit and clock sigmas together by
+SISRE_fit / SISRE_default (one station cannot separate orbit from clock; BDS from its MEO class, and
+``bds_geo_igso_sigma_scale`` = GEO/IGSO over MEO), with the global-average weights of Montenbruck et al. (2018):
+w_R = 0.98, w_A,C^2 = 1/49 (GPS) and 0.98, 1/54 (BDS MEO).
 
 Limits: the broadcast group delays are good to a few decimetres; C1C's differential code bias to P1 (decimetres)
 is not removed and lands in the SISRE; BDS GEO/IGSO passes get the MEO weights; a receiver antenna's phase
