@@ -106,9 +106,13 @@ def test_twin_of_kms3_with_fit(tmp_path, capsys):
     assert c["disagreement_max_elevation_deg"] < 6.0
     # the horizon profile: the twin predicted from the default twin cut by the profile is what the calibrated
     # twin (simulated with the profile as [[environment.body_mask]]) tracks
-    hz, c = fid["horizon"]["in_sample"], fid["fitted"]
-    assert c["visibility_agreement"] == hz["agreement"] >= 0.98
-    assert (c["tracked_real_not_twin"], c["tracked_twin_not_real"]) == (hz["real_not_twin"], hz["twin_not_real"])
+    # twin (simulated with the profile as [[environment.body_mask]] and the fitted acquisition delay) tracks;
+    # the acquisition model predicted on the default twin's grid is what the calibrated twin scores
+    hz, c, acq = fid["horizon"]["in_sample"], fid["fitted"], fid["acquisition"]
+    assert acq["agreement_without"] == hz["agreement"] >= 0.98
+    assert c["visibility_agreement"] == acq["agreement_with"] >= hz["agreement"]
+    # C24 rises at 120 s (0.8 deg) and is first tracked one epoch later, at 0.9 deg
+    assert [(r["sat"], r["delay_s"]) for r in acq["rising"]] == [("C24", 30.0)] and acq["delay_s"] == 30.0
     assert fid["holdout"]["visibility_agreement"] > 0.97       # fitted on the first half, checked on the second
     ratios = {k: [x for v in fid[k]["code_noise_ratio"].values() for x in v if x] for k in ("default", "fitted")}
     ratios["holdout"] = [x for v in fid["holdout"]["code_noise_ratio"].values() for x in v if x]
@@ -119,6 +123,13 @@ def test_twin_of_kms3_with_fit(tmp_path, capsys):
     fragment = tomllib.loads((out / "fitted.toml").read_text())
     assert set(fragment["gnss"]["code_error_scale"]) == set(fid["signals"])
     assert len(fragment["environment"]["body_mask"][0]["azimuth_deg"]) == 72
+    assert fragment["gnss"]["acquisition"] == {"delay_s": 30.0}
+    te = fragment["gnss"]["truth_errors"]
+    sis = fid["sisre_troposphere"]["systems"]
+    assert {"G", "C", "C_geo"} <= set(sis) and 0.3 < sis["G"]["sisre_m"] < 1.5     # GPS broadcast: 0.5-1 m
+    assert te["gps_clock_sigma_m"] == pytest.approx(0.5 * sis["G"]["sisre_m"] / 0.53, rel=0.02)
+    assert "tropo_zwd_random_walk_m_per_sqrt_h" not in te
+    assert "Broadcast orbit/clock (SISRE)" in report and "Acquisition of rising satellites" in report
     for name in ("tracked.png", "code_noise.png", "twin.h5", "twin_fit.h5", "real.h5"):
         assert (out / name).is_file()
 
@@ -148,6 +159,27 @@ def test_the_fitted_fragment_is_a_valid_gnss_section(tmp_path):
     sc["gnss"]["signals"] = ["L1C", "L2W"]
     assert load(sc).gnss.code_error_scale == tables
     assert loaded.gnss.multipath.carrier_sigma_m == pytest.approx(0.01)
+
+
+def test_the_fragment_with_truth_errors_and_acquisition_loads():
+    from simkit.scenario import load
+
+    p = dict(twin.DEFAULTS, iono_residual_fraction=0.2, acquisition={"delay_s": 30.0},
+             truth_errors={"tropo_mapping": "niell", "gps_orbit_sigma_rac_m": [0.2, 0.8, 0.5],
+                           "gps_clock_sigma_m": 0.7, "bds_geo_igso_sigma_scale": 4.0})
+    fragment = tomllib.loads(twin.toml_fragment(p))
+    real = {"t": np.arange(20) * 30.0, "signals": ["L1C"], "start": (2213, 295200.0)}
+    sc = twin.scenario(real, np.array([3516213.438, 781859.8595, 5246037.966]), [str(KMS3_NAV)], 5.0, {}, 1)
+    sc["gnss"]["truth_errors"] = fragment["gnss"]["truth_errors"]
+    sc["gnss"]["acquisition"] = fragment["gnss"]["acquisition"]
+    g = load(sc).gnss
+    assert g.acquisition.delay_s == 30.0 and g.truth_errors.iono_residual_fraction == pytest.approx(0.2)
+    assert g.truth_errors.ephemeris["G"].clock_sigma_m == pytest.approx(0.7)
+    assert g.truth_errors.ephemeris["C"].geosync_scale == pytest.approx(4.0)
+    # the twin's own scenario carries the same keys
+    sc2 = twin.scenario(real, np.array([3516213.438, 781859.8595, 5246037.966]), [str(KMS3_NAV)], 5.0, p, 1)
+    assert sc2["gnss"]["acquisition"] == {"delay_s": 30.0}
+    assert sc2["gnss"]["truth_errors"]["gps_clock_sigma_m"] == 0.7
 
 
 @pytest.mark.slow

@@ -12,6 +12,7 @@ import numpy as np
 from ..errors import ScenarioError
 from ..section import Section, in_range, non_negative, positive
 from . import clock, signals
+from .acquisition import AcquisitionConfig, parse_acquisition
 from .truth_config import TruthErrorsConfig, parse_truth_errors
 
 ERROR_TERMS = ("receiver_clock", "satellite_clock", "group_delay", "ionosphere", "troposphere", "multipath",
@@ -87,6 +88,7 @@ class GnssConfig:
     code_error_scale: dict = field(default_factory=dict)  # signal -> factor (or (el_deg, factor) table) on code noise + multipath
     cn0_offset_db: dict = field(default_factory=dict)  # signal -> dB added to the signal table's C/N0 offset
     truth_errors: TruthErrorsConfig | None = None  # departures of the truth from the receiver's models; None: off
+    acquisition: AcquisitionConfig = field(default_factory=AcquisitionConfig)  # rising satellites' first track
 
     @property
     def nav_systems(self) -> str:
@@ -133,7 +135,8 @@ def parse_config(sec: Section) -> GnssConfig:
         iono_coefficients=_ionosphere(sec.section("ionosphere")),
         code_error_scale=_code_scale(sec.section("code_error_scale"), sigs),
         cn0_offset_db=_cn0_offset(sec.section("cn0_offset_db"), sigs),
-        truth_errors=parse_truth_errors(sec.section("truth_errors")))
+        truth_errors=parse_truth_errors(sec.section("truth_errors")),
+        acquisition=parse_acquisition(sec.section("acquisition")))
     sec.done()
     return cfg
 

@@ -36,12 +36,16 @@ def rac_axes(pos, vel_inertial):
 
 class EphemerisErrors:
     """Orbit (RAC) and clock errors of satellites ``sat_ids`` under scenario ``seed``; ``systems`` maps a system
-    letter to its :class:`EphemerisErrorConfig` (satellites of other systems get none)."""
+    letter to its :class:`EphemerisErrorConfig` (satellites of other systems get none); the sigmas of GEO and
+    IGSO satellites (``orbit_type``) are multiplied by their system's ``geosync_scale``."""
 
-    def __init__(self, seed: int, sat_ids, systems: dict[str, EphemerisErrorConfig]):
+    def __init__(self, seed: int, sat_ids, systems: dict[str, EphemerisErrorConfig], orbit_type=None):
         self.seed, self.sat_ids = seed, list(sat_ids)
         cfgs = [systems.get(s[0]) for s in self.sat_ids]
         self.sigma = np.array([(*c.orbit_sigma_rac_m, c.clock_sigma_m) if c else (0.0,) * 4 for c in cfgs])
+        if orbit_type is not None:   # ``orbit_type`` (S,) 'MEO'/'IGSO'/'GEO': geosynchronous ones scaled
+            geo = np.isin(np.asarray(orbit_type), ("GEO", "IGSO"))
+            self.sigma *= np.where(geo, [c.geosync_scale if c else 1.0 for c in cfgs], 1.0)[:, None]
         self.interval = np.array([c.interval_s if c else 7200.0 for c in cfgs])
         self.departs = bool(np.any(self.sigma > 0))
         self._coef: dict[tuple[int, int], np.ndarray] = {}

@@ -30,6 +30,7 @@ from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
 from ..errors import DataFileError, ScenarioError
 from . import atmosphere, noise, signals as sigmod, tworay
+from .acquisition import Acquisition
 from .clock import ClockProcess
 from .config import GnssConfig, check_sats, code_scale_at
 from .draws import KeyedNormals
@@ -95,6 +96,7 @@ class GnssSimulator:
                               (self.n_ant, len(self.sat_ids), len(self.signals), 2))
         self.tracking = Tracking(cfg, seed, self.sat_ids, self.n_ant)
         self.vis = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)
+        self.acquisition = Acquisition(cfg.acquisition, self.n_ant, len(self.sat_ids))
         self.nlos = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)   # tracking a reflection only
         self.sat_index = {sid: k for k, sid in enumerate(self.sat_ids)}
         self._truth_models(seed)
@@ -128,7 +130,8 @@ class GnssSimulator:
         tropo = TruthTroposphere(seed, self.start_week, self.start_sow, self.duration_s, te.tropo_mapping,
                                  te.tropo_zhd_sigma_m, te.tropo_zwd_sigma_m, te.tropo_zwd_random_walk_m_per_sqrt_h)
         self.truth_tropo = tropo if tropo.departs else None
-        eph = EphemerisErrors(seed, self.sat_ids, te.ephemeris)
+        kinds = {sid: k for c in self.sky.constellations for sid, k in zip(c.sat_ids, c.orbit_type)}
+        eph = EphemerisErrors(seed, self.sat_ids, te.ephemeris, [kinds.get(sid, "MEO") for sid in self.sat_ids])
         self.ephemeris = eph if eph.departs else None
 
     def _group_delays(self) -> np.ndarray:
@@ -199,6 +202,7 @@ class GnssSimulator:
             los = self.env.classify(ant_pos, view.lla, view.vel_enu, view.los, view.azimuth, view.elevation,
                                     view.azimuth_rate, view.elevation_rate, c_be)
         vis_c, off = self._visibility(t, view, c_be, cand, los)
+        vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         k0 = int(round(t[0] * self.cfg.rate_hz))
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
         parts = _Parts(self, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los)

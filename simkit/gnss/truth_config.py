@@ -26,6 +26,7 @@ class EphemerisErrorConfig:
     orbit_sigma_rac_m: tuple[float, float, float]
     clock_sigma_m: float
     interval_s: float
+    geosync_scale: float = 1.0     # factor on both for geosynchronous (GEO, IGSO) satellites
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,7 @@ _REALISTIC = {
     "tropo_zwd_random_walk_m_per_sqrt_h": 0.01,
     "gps_orbit_sigma_rac_m": [0.15, 0.6, 0.4], "gps_clock_sigma_m": 0.5, "gps_ephemeris_interval_s": 7200.0,
     "bds_orbit_sigma_rac_m": [0.3, 1.2, 0.8], "bds_clock_sigma_m": 0.9, "bds_ephemeris_interval_s": 3600.0,
+    "bds_geo_igso_sigma_scale": 1.0,
 }
 _NONE = dict(_REALISTIC, iono_residual_fraction=0.0, tropo_mapping="model", tropo_zhd_sigma_m=0.0,
              tropo_zwd_sigma_m=0.0, tropo_zwd_random_walk_m_per_sqrt_h=0.0, gps_orbit_sigma_rac_m=[0.0] * 3,
@@ -79,7 +81,9 @@ def parse_truth_errors(sec: Section) -> TruthErrorsConfig:
                                             shape=3, check=_all_non_negative)),
             clock_sigma_m=sec.get(f"{name}_clock_sigma_m", float, d[f"{name}_clock_sigma_m"], check=non_negative),
             interval_s=sec.get(f"{name}_ephemeris_interval_s", float, d[f"{name}_ephemeris_interval_s"],
-                               check=in_range(60.0, 86400.0)))
+                               check=in_range(60.0, 86400.0)),
+            geosync_scale=sec.get("bds_geo_igso_sigma_scale", float, d["bds_geo_igso_sigma_scale"],
+                                  check=in_range(0.0, 20.0)) if letter == "C" else 1.0)
     ionex = sec.get("ionex_file", str, None)
     if ionex is not None and not ionex.strip():
         raise sec.error("ionex_file", "expected a file path, got an empty string")

@@ -24,7 +24,7 @@ from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
 from ..gnss.config import code_scale_at
-from . import fidelity, horizon, importer, ionosphere
+from . import acquisition, fidelity, horizon, importer, ionosphere, sisre
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -44,7 +44,7 @@ def real_arrays(imported: importer.Imported) -> dict:
             "obs": {k: {s: d[f"gnss/obs/{s}/{k}"][:, 0] for s in signals} for k in KINDS},
             "reference": d.get("reference/pos_ecef"), "start": (int(imported.attrs["start_gps_week"]),
                                                                  float(imported.attrs["start_gps_sow"])),
-            "group_delay": d.get("gnss/group_delay"),
+            "group_delay": d.get("gnss/group_delay"), "sat_clock": d.get("gnss/sat_clock"),
             "iono": {str(k): (a, b) for k, a, b in zip(d.get("gnss/iono_systems", []), d.get("gnss/iono_alpha", []),
                                                           d.get("gnss/iono_beta", []))}}
 
@@ -57,6 +57,7 @@ def file_arrays(path) -> dict:
         g = read_gnss(ds, antennas=0, obs=KINDS)
         return {"t": g.t, "sat_id": [str(s) for s in g.sat_id], "signals": list(g.signals),
                 "freq": C_LIGHT / g.wavelength_m, "sat_pos": g.sat_pos_ecef, "obs": g.obs, "reference": None,
+                "sat_clock": g.sat_clock, "group_delay": g.group_delay,
                 "start": (int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]))}
 
 
@@ -105,8 +106,11 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
                                "correlation_time_s": p["mp_correlation_time_s"]},
-                 **({"truth_errors": {"iono_residual_fraction": p["iono_residual_fraction"]}}
-                    if p.get("iono_residual_fraction") is not None else {})},
+                 **({"truth_errors": {**({"iono_residual_fraction": p["iono_residual_fraction"]}
+                                         if p.get("iono_residual_fraction") is not None else {}),
+                                      **p.get("truth_errors", {})}}
+                    if p.get("iono_residual_fraction") is not None or p.get("truth_errors") else {}),
+                 **({"acquisition": dict(p["acquisition"])} if p.get("acquisition") else {})},
         **({"environment": {"reflections": False, "body_mask": [dict(p["horizon_mask"])]}}
            if p.get("horizon_mask") else {}),
     }
@@ -160,6 +164,7 @@ def on_twin_grid(real: dict, twin: dict) -> dict:
             a[np.ix_(np.flatnonzero(keep_r), cols[keep_c])] = src
             obs[kind][sig] = a
     return {**real, "t": twin["t"], "sat_id": twin["sat_id"], "obs": obs, "sat_pos": twin["sat_pos"],
+            "sat_clock": twin.get("sat_clock"),
             "not_in_twin": [real["sat_id"][i] for i in np.flatnonzero(~keep_c)]}
 
 
@@ -247,6 +252,10 @@ def fit_parameters(real: dict, reference) -> dict:
         iono = ionosphere.klobuchar_ratio(real, reference, real["group_delay"], real["iono"])
         p["_ionosphere"] = iono
         p["iono_residual_fraction"] = ionosphere.residual_fraction(iono)
+    if real.get("sat_clock") is not None and not real.get("trajectory"):   # a static station with a known position
+        p["_sisre"] = sisre.fit(sisre.residuals(real, reference))
+        p["truth_errors"], more = sisre.parameters(p["_sisre"], float(real["t"][-1] - real["t"][0]))
+        notes += more
     if p.get("iono_residual_fraction") is None:
         notes.append("no dual-frequency GPS or BDS code and carrier with a Klobuchar model: the truth "
                      "ionosphere's residual left at the default")
@@ -411,6 +420,14 @@ def toml_fragment(p: dict) -> str:
     if p.get("iono_residual_fraction") is not None:
         lines += ["", "# the real ionosphere against Klobuchar (dual-frequency geometry-free, carrier-levelled code)",
                   "[gnss.truth_errors]", f"iono_residual_fraction = {p['iono_residual_fraction']:.4f}"]
+    if p.get("truth_errors"):
+        if p.get("iono_residual_fraction") is None:
+            lines += ["", "[gnss.truth_errors]"]
+        lines += ["# broadcast orbit/clock (SISRE) and troposphere from ionosphere-free code residuals (sisre.py)"]
+        lines += [f"{k} = {_toml_value(v)}" for k, v in p["truth_errors"].items()]
+    if p.get("acquisition"):
+        lines += ["", "# rising satellites: first tracked this long after they cross the mask (acquisition.py)",
+                  "[gnss.acquisition]", f"delay_s = {p['acquisition']['delay_s']:.1f}"]
     if p.get("horizon_mask"):
         tab = p["horizon_mask"]
         lines += ["", "# the station's horizon profile (a level antenna facing north: body azimuth = azimuth)",
@@ -418,6 +435,14 @@ def toml_fragment(p: dict) -> str:
                   f"azimuth_deg = [{', '.join(f'{a:g}' for a in tab['azimuth_deg'])}]",
                   f"elevation_deg = [{', '.join(f'{e:g}' for e in tab['elevation_deg'])}]"]
     return "\n".join(lines) + "\n"
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(f"{x:.4f}" for x in v) + "]"
+    return f"{v:.4f}"
 
 
 def _scale_toml(v) -> str:
@@ -452,6 +477,19 @@ def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> d
             "holdout": horizon.holdout(el, az, real_on, twin_on, floor)}
 
 
+def fit_acquisition(real_on_grid: dict, twin: dict, reference, mask_deg: float, table=None) -> dict:
+    """The acquisition delay of rising satellites (:mod:`.acquisition`) from the real tracking on the twin's grid
+    and the default twin ``twin`` (its geometry seen from ``reference``, cut by the horizon ``table`` if any)."""
+    rx = np.broadcast_to(np.asarray(reference, float), (twin["t"].size, 3))
+    with np.errstate(invalid="ignore"):
+        el, az = angles_from_enu(lines_of_sight_enu(rx, twin["sat_pos"])[0])
+    out = acquisition.fit(twin["t"], el, az, fidelity.tracked(twin["obs"]), fidelity.tracked(real_on_grid["obs"]),
+                          mask_deg, table)
+    for r in out["rising"]:
+        r["sat"] = twin["sat_id"][r.pop("column")]
+    return out
+
+
 def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     """The fitted parameters of ``real`` (:func:`fit_parameters`, the horizon profile, then the carrier, Doppler
     and code terms scaled from a default and a first calibrated twin, and the code factors made tables over
@@ -463,20 +501,25 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     fitted = fit_parameters(real, ref)
     notes = fitted.pop("_notes")
     iono = fitted.pop("_ionosphere", None)
+    range_errors = fitted.pop("_sisre", None)
     hz = None
     if not real.get("trajectory"):       # a horizon profile belongs to a fixed antenna
         hz = fit_horizon(default[1], default[2], ref, mask)
         fitted["horizon_mask"] = hz["table"]
+    acq = fit_acquisition(default[1], default[2], ref, mask, hz["table"] if hz else None)
+    if acq["delay_s"] > 0:
+        fitted["acquisition"] = {"delay_s": acq["delay_s"]}
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
     first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
     tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
     fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
-    return fitted, notes, {"horizon": hz, "ionosphere": iono}
+    return fitted, notes, {"horizon": hz, "ionosphere": iono, "sisre_troposphere": range_errors, "acquisition": acq}
 
 
 def _rows(arr: dict, rows) -> dict:
     """``arr`` (a twin or real dict) cut to the epochs ``rows`` (bool (M,))."""
     return {**arr, "t": arr["t"][rows], "sat_pos": arr["sat_pos"][rows],
+            **({"sat_clock": arr["sat_clock"][rows]} if arr.get("sat_clock") is not None else {}),
             "obs": {k: {s: v[rows] for s, v in d.items()} for k, d in arr["obs"].items()}}
 
 
@@ -634,6 +677,7 @@ def report_markdown(fid: dict, figures=()) -> str:
     if "fitted_parameters" in fid:
         out += ["", "## Fitted [gnss] parameters", "", "```toml", toml_fragment(fid["fitted_parameters"]).rstrip(),
                 "```"] + [f"- {n}" for n in fid.get("fit_notes", [])]
+    out += sisre.report_lines(fid.get("sisre_troposphere")) + acquisition.report_lines(fid.get("acquisition"))
     out += [""] + [f"![{Path(p).stem}]({Path(p).name})" for p in figures]
     return "\n".join(out) + "\n"
 
