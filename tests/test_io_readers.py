@@ -44,7 +44,11 @@ def test_read_imu_and_read_gnss_select_what_is_asked(small):
         assert np.array_equal(imu.errors["gyro_bias"], f["imu/errors/gyro_bias"][5:50])
         sig = f["gnss/signals"].asstr()[-1]
         g = read_gnss(ds, signals=[sig], antennas=1, epochs=slice(1, None, 2), obs=("carrier",),
-                      truth=("elevation", f"{sig}/noise_code", "no_such_term"))
+                      truth=("elevation", f"{sig}/noise_code", "no_such_term", "satellite_clock_error",
+                             "orbit_error_rac"))
+        # per-satellite truth (M, S, ...) keeps every satellite: antennas=1 is not its column 1
+        for name in ("satellite_clock_error", "orbit_error_rac"):
+            assert np.array_equal(g.truth[name], f[f"gnss/truth/{name}"][1::2], equal_nan=True), name
         assert g.signals == (sig,) and n_antennas(ds) == f["gnss/antennas/lever_arm_b"].shape[0]
         assert np.array_equal(g.obs["carrier"][sig], f[f"gnss/obs/{sig}/carrier"][1::2, 1], equal_nan=True)
         assert np.array_equal(g.truth["elevation"], f["gnss/truth/elevation"][1::2, 1], equal_nan=True)

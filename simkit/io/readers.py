@@ -14,6 +14,7 @@ import numpy as np
 from .. import frames, quat
 from ..earth import C_LIGHT
 from ..errors import DataFileError
+from . import schema
 
 # group names of :func:`has`, keyed so that callers need not spell HDF5 paths
 GROUPS = {"truth": "truth", "imu": "imu", "imu_errors": "imu/errors", "gnss": "gnss", "antennas": "gnss/antennas",
@@ -204,13 +205,16 @@ def read_gnss(ds, signals=None, antennas=None, epochs=None, obs=(), truth=(), sa
     return Gnss(ds["gnss/t"][m], ds["gnss/sat_id"][:], names, lam, gd,
                 ds["gnss/antennas/lever_arm_b"][:][a], *sats,
                 obs={k: {s: ds[f"gnss/obs/{s}/{k}"][m, a] for s in names} for k in obs},
-                truth={k: _gnss_truth(ds[f"gnss/truth/{k}"], m, a) for k in truth if f"gnss/truth/{k}" in ds},
+                truth={k: _gnss_truth(ds[f"gnss/truth/{k}"], f"gnss/truth/{k}", m, a) for k in truth
+                       if f"gnss/truth/{k}" in ds},
                 sat_wavelength_m=sat_lam)
 
 
-def _gnss_truth(array, m, a):
-    """A /gnss/truth array (M, A, ...) at epochs ``m`` and antennas ``a``."""
-    return array[m, a] if array.ndim > 1 else array[m]
+def _gnss_truth(array, path: str, m, a):
+    """The /gnss/truth array at ``path`` at epochs ``m`` and, where its declared shape has an antenna axis
+    (M, A, ...), antennas ``a``; per-satellite arrays (M, S, ...) keep every satellite."""
+    per_antenna = tuple(schema.field(path).shape[:2]) == ("M", "A")
+    return array[m, a] if per_antenna else array[m]
 
 
 def broadcast_ionosphere(ds):
