@@ -24,7 +24,7 @@ from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
 from ..gnss.config import code_scale_at
-from . import fidelity, horizon, importer, ionosphere
+from . import fidelity, horizon, importer, ionosphere, noise_fit
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -238,7 +238,7 @@ def fit_parameters(real: dict, reference) -> dict:
         notes.append("too few code-minus-carrier bins: code noise and multipath left at the defaults")
     else:
         p["mp_code_sigma_m"], p["mp_elevation_scale_deg"], p["code_error_scale"] = code
-    rho = _lag_one(st["_series"]["mp"])
+    rho = noise_fit.lag_one(np.concatenate(list(st["_series"]["mp"].values()), axis=1))
     if rho is not None and 0.0 < rho < 1.0:
         p["mp_correlation_time_s"] = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0))
     rates = [v for v in st["slips_per_hour"].values() if v is not None]
@@ -379,17 +379,6 @@ def _fit_code(st, sigs, centres, dll):
             {sigs[k].name: float(np.exp(x[2 + i])) for i, k in enumerate(used)})
 
 
-def _lag_one(series: dict):
-    """Pooled lag-one autocorrelation of the multipath series (pairs of consecutive finite values)."""
-    num = den = 0.0
-    for x in series.values():
-        a, b = x[:-1], x[1:]
-        ok = np.isfinite(a) & np.isfinite(b)
-        num += float(np.sum(a[ok] * b[ok]))
-        den += float(np.sum(a[ok] ** 2))
-    return num / den if den > 0 else None
-
-
 def toml_fragment(p: dict) -> str:
     """The fitted parameters as the [gnss] TOML fragment of a scenario (the calibrated twin)."""
     lines = ["# simkit twin --fit: [gnss] error parameters estimated from the real file (docs/real_data.md)", "[gnss]",
@@ -428,13 +417,39 @@ def _scale_toml(v) -> str:
 
 
 def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress, arrays=False):
+    """One twin of ``real`` with ``params``: its comparison (and the real arrays on its grid and its own). The twin
+    keeps only the epochs the real arrays have (``real`` may be a subset of a file's epochs: a split)."""
     from ..pipeline import run
 
     run(scenario(real, ref, nav_paths, mask, params, seed), out=path, progress=progress, force=True)
     twin = file_arrays(path)
+    twin = _rows(twin, _align(real, twin)[1] >= 0)
     on_grid = on_twin_grid(real, twin)
     result = compare(on_grid, twin, ref, mask)
     return (result, on_grid, twin) if arrays else result
+
+
+def _realisations(real, ref, nav_paths, mask, params, seeds, path, progress):
+    """Twins of ``real`` with ``params`` for each of ``seeds``: (the real arrays on their grid, [twin arrays])."""
+    runs = [_twin_once(real, ref, nav_paths, mask, params, s, path, progress, arrays=True) for s in seeds]
+    return runs[0][1], [r[2] for r in runs]
+
+
+def noise_check(real_grid: dict, twins: list, ref, mask: float, rows=None) -> dict:
+    """:func:`.noise_fit.code_comparison` (equal-count bins, twin over its realisations) and
+    :func:`.noise_fit.cn0_comparison` (the fixed bins) of the real arrays on the twins' grid against ``twins``,
+    on the epochs ``rows`` (bool; all when None)."""
+    if rows is not None:
+        real_grid, twins = _rows(real_grid, rows), [_rows(t, rows) for t in twins]
+    el = fidelity.elevations(twins[0]["sat_pos"], ref)
+
+    def mp(a):
+        return fidelity.multipath(a["obs"], a["signals"], np.asarray(a["freq"]), a["t"])
+
+    code = noise_fit.code_comparison(mp(real_grid), [mp(t) for t in twins], el, mask)
+    cn0 = noise_fit.cn0_comparison(real_grid["obs"]["cn0"], [t["obs"]["cn0"] for t in twins], el,
+                                   fidelity.ELEVATION_EDGES_DEG)
+    return {"code_noise": code, "cn0": cn0, "epochs": int(twins[0]["t"].size)}
 
 
 def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> dict:
@@ -452,12 +467,23 @@ def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> d
             "holdout": horizon.holdout(el, az, real_on, twin_on, floor)}
 
 
-def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
+REALISATIONS = 4          # twins (seeds) whose pooled statistics are the twin's expectation in a noise check
+CODE_MODELS = ("smooth", "bins")
+
+
+def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None, code_model="smooth",
+               realisations=REALISATIONS):
     """The fitted parameters of ``real`` (:func:`fit_parameters`, the horizon profile, then the carrier, Doppler
-    and code terms scaled from a default and a first calibrated twin, and the code factors made tables over
-    elevation), the fit's notes and {"horizon": :func:`fit_horizon`, "ionosphere": the Klobuchar comparison of
-    :func:`.ionosphere.klobuchar_ratio`}; ``default`` = (comparison, real on the grid, twin arrays)
-    of a default twin already run on ``real``."""
+    and code terms scaled from a default and a first calibrated twin), the fit's notes and {"horizon":
+    :func:`fit_horizon`, "ionosphere": the Klobuchar comparison of :func:`.ionosphere.klobuchar_ratio`};
+    ``default`` = (comparison, real on the grid, twin arrays) of a default twin already run on ``real``.
+
+    ``code_model``: "smooth" (the code factor per signal corrected by a line in elevation through the log
+    twin / real ratios of ``realisations`` first twins in equal-count bins, :func:`.noise_fit.smooth_correction`:
+    two parameters per signal) or "bins" (a free factor per 10-degree bin from one first twin,
+    :func:`code_tables`)."""
+    if code_model not in CODE_MODELS:
+        raise InputError("code_model", f"expected one of {', '.join(CODE_MODELS)}, got {code_model!r}")
     if default is None:
         default = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed, path, progress, arrays=True)
     fitted = fit_parameters(real, ref)
@@ -468,9 +494,18 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
         hz = fit_horizon(default[1], default[2], ref, mask)
         fitted["horizon_mask"] = hz["table"]
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
-    first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
-    tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
-    fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
+    if code_model == "bins":
+        first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
+        tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
+        fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
+    else:
+        grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
+                                    [seed + 1 + 100 * k for k in range(realisations)], path, progress)
+        first = compare(grid, twins[0], ref, mask)
+        code = noise_check(grid, twins, ref, mask)["code_noise"]["signals"]
+        tables = noise_fit.smooth_correction(code, fitted.get("code_error_scale", {}))
+        fitted = rescale(fitted, first)
+        fitted["code_error_scale"] = {**fitted["code_error_scale"], **tables}
     return fitted, notes, {"horizon": hz, "ionosphere": iono}
 
 
@@ -480,28 +515,50 @@ def _rows(arr: dict, rows) -> dict:
             "obs": {k: {s: v[rows] for s, v in d.items()} for k, d in arr["obs"].items()}}
 
 
-def _holdout(real, ref, nav_paths, mask, seed, path, progress) -> dict:
-    """Out-of-sample check of the fit: every parameter (horizon profile and code tables included) fitted on the
-    first half of the epochs only, a twin of the whole span run with them, and the comparison on the second half
-    (neither the fit nor its twins saw it)."""
-    first_half = real["t"] < real["t"][0] + 0.5 * (real["t"][-1] - real["t"][0])
-    fitted, _, extras = _calibrate(_rows(real, first_half), ref, nav_paths, mask, seed + 10, path, progress)
-    from ..pipeline import run
+SPLITS = ("half", "interleaved")
+MAX_BLOCKS = 6
 
-    run(scenario(real, ref, nav_paths, mask, fitted, seed + 12), out=path, progress=progress, force=True)
-    twin = file_arrays(path)
-    grid = on_twin_grid(real, twin)
-    second = twin["t"] >= real["t"][~first_half][0] - 1e-6
-    out = compare(_rows(grid, second), _rows(twin, second), ref, mask)
-    return {"fitted_on_s": [float(real["t"][first_half][0]), float(real["t"][first_half][-1])],
-            "checked_on_s": [float(twin["t"][second][0]), float(twin["t"][second][-1])],
+
+def split_rows(t, kind: str):
+    """The epochs (bool (M,)) a split fits on; the others are checked. "half": the first half of the span.
+    "interleaved": the span cut into equal blocks, as many as leave each block at least ``fidelity.MIN_ARC`` + 1
+    epochs (at most ``MAX_BLOCKS``, at least 3), fitted on the even blocks and checked on the odd ones: along a
+    drive the environment changes, and a first / second half split mixes that change with the model's error."""
+    t = np.asarray(t, float)
+    span = t[-1] - t[0]
+    if kind == "half":
+        return t < t[0] + 0.5 * span
+    if kind != "interleaved":
+        raise InputError("split", f"expected one of {', '.join(SPLITS)}, got {kind!r}")
+    n = int(np.clip(t.size // (fidelity.MIN_ARC + 1), 3, MAX_BLOCKS))
+    block = np.minimum(np.floor((t - t[0]) / span * n), n - 1) if span > 0 else np.zeros(t.size)
+    return block % 2 == 0
+
+
+def _holdout(real, ref, nav_paths, mask, seed, path, progress, split="half", code_model="smooth",
+             realisations=REALISATIONS) -> dict:
+    """Out-of-sample check of the fit: every parameter (horizon profile and code tables included) fitted on the
+    epochs :func:`split_rows` keeps, twins of the whole span run with them (``realisations`` seeds), and the
+    comparison on the other epochs (neither the fit nor its twins saw them)."""
+    fit_rows = split_rows(real["t"], split)
+    fitted, _, extras = _calibrate(_rows(real, fit_rows), ref, nav_paths, mask, seed + 10, path, progress,
+                                   code_model=code_model, realisations=realisations)
+    grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
+                                [seed + 12 + 100 * k for k in range(realisations)], path, progress)
+    check = ~fit_rows[np.clip(_align(real, twins[0])[1], 0, None)]
+    out = compare(_rows(grid, check), _rows(twins[0], check), ref, mask)
+    tc = twins[0]["t"]
+    return {"split": split, "code_model": code_model,
+            "fitted_on_s": [float(x) for x in real["t"][fit_rows][[0, -1]]],
+            "checked_on_s": [float(x) for x in tc[check][[0, -1]]], "checked_epochs": int(check.sum()),
             "visibility_agreement": out["visibility_agreement"],
             "satellite_epochs_above_mask": out["satellite_epochs_above_mask"],
             "tracked_real_not_twin": out["tracked_real_not_twin"], "tracked_twin_not_real": out["tracked_twin_not_real"],
             "code_noise_ratio": out["code_noise_ratio"], "real_code_noise_m": out["real"]["code_noise_m"],
             "cn0_rms_difference_dbhz": out["cn0_rms_difference_dbhz"],
             "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": (extras["horizon"] or {}).get("table"),
-            "iono_residual_fraction": fitted.get("iono_residual_fraction")}
+            "iono_residual_fraction": fitted.get("iono_residual_fraction"),
+            "noise": noise_check(grid, twins, ref, mask, rows=check)}
 
 
 def track_sigma_enu(pos_ecef, centre, window: int = 51) -> list:
@@ -536,14 +593,19 @@ def level_track_csv(rec, centre, name: str) -> str:
 
 
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
-             reference_source=None, progress: bool = False, trajectory=None, trajectory_solution=None) -> dict:
+             reference_source=None, progress: bool = False, trajectory=None, trajectory_solution=None,
+             code_model: str = "smooth", realisations: int = REALISATIONS) -> dict:
     """Import ``obs_path`` (+ ``nav_paths``), simulate its twin into ``out_dir``/twin.h5 (and with ``fit`` the
     calibrated twin_fit.h5), compare; returns the fidelity dict (also the content of fidelity.json).
 
     ``trajectory``: a log of the receiver's path (any ``[trajectory] source``: e.g. the real file's own SPP
     solution, ``real.h5`` with ``trajectory_solution="spp"``): the twin of a moving receiver. Its outlying
     samples are dropped (``outliers = "drop"``); elevations for the statistics are taken from the log's median
-    position (a car's few hundred metres move them by less than 0.01 deg) and no horizon profile is fitted."""
+    position (a car's few hundred metres move them by less than 0.01 deg) and no horizon profile is fitted.
+
+    ``code_model`` and ``realisations``: :func:`_calibrate`'s; the calibrated twin is checked in sample and out of
+    sample on both :data:`SPLITS` (``holdout``: half, ``holdout_interleaved``) over ``realisations`` seeds
+    (:func:`noise_check`)."""
     out_dir = Path(out_dir)
     if not nav_paths:
         raise InputError("--nav", "the twin needs the broadcast navigation file(s) of the observation file")
@@ -574,14 +636,22 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
                                                       out_dir / "twin.h5", progress, arrays=True)
     if fit:
         fitted, notes, extras = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5", progress,
-                                           (result["default"], real_grid, twin0))
+                                           (result["default"], real_grid, twin0), code_model, realisations)
         result.update(extras)
         result["fit_notes"] = notes
         result["fitted_parameters"] = fitted
         (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
-        result["fitted"] = _twin_once(real, ref, nav_paths, mask, fitted, seed + 2, out_dir / "twin_fit.h5",
-                                      progress)
-        result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress)
+        # the last realisation written (twin_fit.h5) is the seed + 2 twin of the fixed-bin comparison
+        grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
+                                    [seed + 2 + 100 * k for k in reversed(range(realisations))],
+                                    out_dir / "twin_fit.h5", progress)
+        result["fitted"] = compare(grid, twins[-1], ref, mask)
+        result["noise"] = {"in_sample": noise_check(grid, twins, ref, mask), "code_model": code_model,
+                           "twin_realisations": realisations}
+        result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress,
+                                     "half", code_model, realisations)
+        result["holdout_interleaved"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5",
+                                                 progress, "interleaved", code_model, realisations)
     (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
     return result
 
