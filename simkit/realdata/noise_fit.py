@@ -55,16 +55,44 @@ def _in_bin(values, el_deg, lo, hi):
     return np.where(inside, values, np.nan)
 
 
+def jackknife_rel_se(x) -> float | None:
+    """Relative standard error of the standard deviation of the finite values of ``x`` (M, S) by the delete-one-
+    column jackknife (Efron & Stein 1981): the satellite is the sampling unit, so the spread between satellites'
+    multipath (one reflector geometry each at a static station) counts, which n_eff of a common series cannot
+    see; None with fewer than three columns."""
+    ok = np.isfinite(x)
+    cols = ok.any(axis=0)
+    k = int(cols.sum())
+    if k < 3:
+        return None
+    x0 = np.where(ok, x, 0.0)[:, cols]
+    n_i, s1_i, s2_i = ok[:, cols].sum(0), x0.sum(0), (x0 ** 2).sum(0)
+    n, s1, s2 = n_i.sum(), s1_i.sum(), s2_i.sum()
+    m = n - n_i
+    keep = m >= 2
+    if keep.sum() < 3:
+        return None
+    var = (s2 - s2_i[keep]) / m[keep] - ((s1 - s1_i[keep]) / m[keep]) ** 2
+    theta = np.sqrt(np.maximum(var, 0.0))
+    kk = theta.size
+    se = np.sqrt((kk - 1) / kk * np.sum((theta - theta.mean()) ** 2))
+    full = np.sqrt(max(s2 / n - (s1 / n) ** 2, 0.0))
+    return float(se / full) if full > 0 else None
+
+
 def bin_sigma(values, el_deg, lo: float, hi: float) -> dict:
-    """{n, rho, n_eff, sigma, rel_se} of ``values`` (M, S) whose elevation (deg) is in [lo, hi): sigma the
-    standard deviation, rel_se = 1 / sqrt(2 n_eff) its relative standard error."""
+    """{n, rho, n_eff, sigma, rel_se, rel_se_satellites} of ``values`` (M, S) whose elevation (deg) is in
+    [lo, hi): sigma the standard deviation; rel_se = 1 / sqrt(2 n_eff) its relative standard error as a common
+    AR(1) series; rel_se_satellites the jackknife over satellites (:func:`jackknife_rel_se`)."""
     x = _in_bin(values, el_deg, lo, hi)
     v = x[np.isfinite(x)]
     if v.size < 3:
-        return {"n": int(v.size), "rho": None, "n_eff": float(v.size), "sigma": None, "rel_se": None}
+        return {"n": int(v.size), "rho": None, "n_eff": float(v.size), "sigma": None, "rel_se": None,
+                "rel_se_satellites": None}
     rho = lag_one(x - np.nanmean(v))
     ne = n_effective(v.size, rho, "variance")
-    return {"n": int(v.size), "rho": rho, "n_eff": ne, "sigma": float(np.std(v)), "rel_se": float(1 / np.sqrt(2 * ne))}
+    return {"n": int(v.size), "rho": rho, "n_eff": ne, "sigma": float(np.std(v)), "rel_se": float(1 / np.sqrt(2 * ne)),
+            "rel_se_satellites": jackknife_rel_se(x)}
 
 
 def bin_mean(values, el_deg, lo: float, hi: float) -> dict:
@@ -96,7 +124,9 @@ def code_comparison(real_mp: dict, twin_mps: list, el, floor_deg: float, edges: 
                     n_eff_min: float = 50.0, max_bins: int = 6) -> dict:
     """Per signal: the code-noise sigma of the real file and of the twin (pooled over the realisations of
     ``twin_mps``) in equal-count elevation bins, over the satellite-epochs both have a value, with their
-    uncertainties, the ratio twin / real and its relative standard error sqrt(rel_se_real^2 + rel_se_twin^2).
+    uncertainties, the ratio twin / real and its relative standard error sqrt(rel_se_real^2 + rel_se_twin^2),
+    the real side's the larger of its n_eff and its jackknife-over-satellites figure (the twin draws every
+    satellite's multipath from one model: its realisations pooled, n_eff is its figure).
 
     ``real_mp`` {signal: (M, S)}, ``twin_mps`` [{signal: (M, S)}] on the same grid (one per seed), ``el`` (M, S)
     rad; ``edges`` {signal: edges} to use given edges (else :func:`equal_count_edges` on the real values)."""
@@ -116,12 +146,15 @@ def code_comparison(real_mp: dict, twin_mps: list, el, floor_deg: float, edges: 
         for lo, hi in zip(e[:-1], e[1:]):
             a, b = bin_sigma(rr, el_deg, lo, hi), bin_sigma(pooled_t, pooled_el, lo, hi)
             ratio = se = None
+            real_se = max(a["rel_se"] or 0.0, a["rel_se_satellites"] or 0.0)
             if a["sigma"] and b["sigma"] is not None:
                 ratio = b["sigma"] / a["sigma"]
-                se = float(np.hypot(a["rel_se"], b["rel_se"]))
+                se = float(np.hypot(real_se, b["rel_se"]))
             rows.append({"bin_deg": [float(lo), float(hi)], "real_m": a["sigma"], "real_n": a["n"],
-                         "real_n_eff": a["n_eff"], "real_rel_se": a["rel_se"], "twin_m": b["sigma"],
-                         "twin_n_eff": b["n_eff"], "twin_rel_se": b["rel_se"], "ratio": ratio, "ratio_rel_se": se})
+                         "real_n_eff": a["n_eff"], "real_rel_se_series": a["rel_se"],
+                         "real_rel_se_satellites": a["rel_se_satellites"], "real_rel_se": real_se or None,
+                         "twin_m": b["sigma"], "twin_n_eff": b["n_eff"], "twin_rel_se": b["rel_se"], "ratio": ratio,
+                         "ratio_rel_se": se})
         out[s] = {"edges_deg": [float(x) for x in e], "bins": rows}
     return {"signals": out, "twin_realisations": len(twin_mps), "summary": code_summary(out)}
 

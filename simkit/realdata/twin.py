@@ -238,7 +238,11 @@ def fit_parameters(real: dict, reference) -> dict:
         notes.append("too few code-minus-carrier bins: code noise and multipath left at the defaults")
     else:
         p["mp_code_sigma_m"], p["mp_elevation_scale_deg"], p["code_error_scale"] = code
-    rho = noise_fit.lag_one(np.concatenate(list(st["_series"]["mp"].values()), axis=1))
+    # the median over signals: a few metre-level series (GLONASS, formed with nominal frequencies) would rule a
+    # pooled estimate
+    rhos = [noise_fit.lag_one(v) for s, v in st["_series"]["mp"].items() if not sigmod.get(s).is_fdma]
+    rhos = [r for r in rhos if r is not None]
+    rho = float(np.median(rhos)) if rhos else None
     if rho is not None and 0.0 < rho < 1.0:
         p["mp_correlation_time_s"] = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0))
     rates = [v for v in st["slips_per_hour"].values() if v is not None]
@@ -443,8 +447,9 @@ def noise_check(real_grid: dict, twins: list, ref, mask: float, rows=None) -> di
         real_grid, twins = _rows(real_grid, rows), [_rows(t, rows) for t in twins]
     el = fidelity.elevations(twins[0]["sat_pos"], ref)
 
-    def mp(a):
-        return fidelity.multipath(a["obs"], a["signals"], np.asarray(a["freq"]), a["t"])
+    def mp(a):   # FDMA (GLONASS): an imported file carries each signal's nominal frequency only, no channel
+        out = fidelity.multipath(a["obs"], a["signals"], np.asarray(a["freq"]), a["t"])
+        return {s: v for s, v in out.items() if not sigmod.get(s).is_fdma}
 
     code = noise_fit.code_comparison(mp(real_grid), [mp(t) for t in twins], el, mask)
     cn0 = noise_fit.cn0_comparison(real_grid["obs"]["cn0"], [t["obs"]["cn0"] for t in twins], el,
