@@ -55,29 +55,31 @@ def _in_bin(values, el_deg, lo, hi):
     return np.where(inside, values, np.nan)
 
 
-def jackknife_rel_se(x) -> float | None:
-    """Relative standard error of the standard deviation of the finite values of ``x`` (M, S) by the delete-one-
-    column jackknife (Efron & Stein 1981): the satellite is the sampling unit, so the spread between satellites'
-    multipath (one reflector geometry each at a static station) counts, which n_eff of a common series cannot
-    see; None with fewer than three columns."""
+def _column_jackknife(x, stat: str) -> float | None:
+    """Standard error of the mean (``stat="mean"``) or standard deviation ("std") of the finite values of
+    ``x`` (M, S) by the delete-one-column jackknife (Efron & Stein 1981); None with fewer than three columns."""
     ok = np.isfinite(x)
     cols = ok.any(axis=0)
-    k = int(cols.sum())
-    if k < 3:
-        return None
     x0 = np.where(ok, x, 0.0)[:, cols]
     n_i, s1_i, s2_i = ok[:, cols].sum(0), x0.sum(0), (x0 ** 2).sum(0)
-    n, s1, s2 = n_i.sum(), s1_i.sum(), s2_i.sum()
-    m = n - n_i
+    m = n_i.sum() - n_i
     keep = m >= 2
     if keep.sum() < 3:
         return None
-    var = (s2 - s2_i[keep]) / m[keep] - ((s1 - s1_i[keep]) / m[keep]) ** 2
-    theta = np.sqrt(np.maximum(var, 0.0))
-    kk = theta.size
-    se = np.sqrt((kk - 1) / kk * np.sum((theta - theta.mean()) ** 2))
-    full = np.sqrt(max(s2 / n - (s1 / n) ** 2, 0.0))
-    return float(se / full) if full > 0 else None
+    mean = (s1_i.sum() - s1_i[keep]) / m[keep]
+    theta = mean if stat == "mean" else np.sqrt(np.maximum((s2_i.sum() - s2_i[keep]) / m[keep] - mean ** 2, 0.0))
+    k = theta.size
+    return float(np.sqrt((k - 1) / k * np.sum((theta - theta.mean()) ** 2)))
+
+
+def jackknife_rel_se(x) -> float | None:
+    """Relative standard error of the standard deviation of the finite values of ``x`` (M, S) by the delete-one-
+    satellite (column) jackknife: the satellite is the sampling unit, so the spread between satellites'
+    multipath (one reflector geometry each at a static station) counts, which n_eff of a common series cannot
+    see; None with fewer than three satellites."""
+    se = _column_jackknife(x, "std")
+    v = x[np.isfinite(x)]
+    return float(se / np.std(v)) if se is not None and v.size and np.std(v) > 0 else None
 
 
 def bin_sigma(values, el_deg, lo: float, hi: float) -> dict:
@@ -96,13 +98,17 @@ def bin_sigma(values, el_deg, lo: float, hi: float) -> dict:
 
 
 def bin_mean(values, el_deg, lo: float, hi: float) -> dict:
-    """{n, n_eff, mean, se} of ``values`` (M, S) in the elevation bin [lo, hi) deg: se = std / sqrt(n_eff)."""
+    """{n, satellites, n_eff, mean, se} of ``values`` (M, S) in the elevation bin [lo, hi) deg: se the larger of
+    std / sqrt(n_eff) and the jackknife over satellites (a bin's mean C/N0 is mostly which satellites, clear or
+    shadowed, happen to be in it)."""
     x = _in_bin(values, el_deg, lo, hi)
     v = x[np.isfinite(x)]
+    sats = int(np.isfinite(x).any(axis=0).sum())
     if v.size < 3:
-        return {"n": int(v.size), "n_eff": float(v.size), "mean": None, "se": None}
+        return {"n": int(v.size), "satellites": sats, "n_eff": float(v.size), "mean": None, "se": None}
     ne = n_effective(v.size, lag_one(x - v.mean()))
-    return {"n": int(v.size), "n_eff": ne, "mean": float(v.mean()), "se": float(np.std(v) / np.sqrt(ne))}
+    se = max(float(np.std(v) / np.sqrt(ne)), _column_jackknife(x, "mean") or 0.0)
+    return {"n": int(v.size), "satellites": sats, "n_eff": ne, "mean": float(v.mean()), "se": se}
 
 
 def equal_count_edges(values, el_deg, floor_deg: float, n_eff_min: float = 50.0, max_bins: int = 6) -> list:
@@ -178,8 +184,10 @@ def code_summary(per_signal: dict, tol: float = TOLERANCE) -> dict:
 
 def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
     """Per signal: mean C/N0 (dB-Hz) of real and twin (pooled over realisations) per elevation bin over the
-    satellite-epochs both track, with standard errors (n_eff from the lag-one autocorrelation), and the
-    difference twin - real split into its bias (mean over bins), scatter (std over bins) and RMS."""
+    satellite-epochs both track, with standard errors (:func:`bin_mean`), and the difference twin - real split
+    into its bias (mean over bins), scatter (std over bins) and RMS; ``rms_se_dbhz`` the RMS of the differences'
+    standard errors (the RMS that sampling alone would give) and ``chi2_per_bin`` the mean squared difference in
+    standard errors (about 1 when the bins differ by sampling only)."""
     el_deg = np.degrees(el)
     out = {}
     for s, r in real_cn0.items():
@@ -190,18 +198,24 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
         rr = np.where(np.any(both, axis=0), r, np.nan)
         pooled = np.concatenate([np.where(b, t, np.nan) for b, t in zip(both, twins)], axis=1)
         pel = np.tile(el_deg, (1, len(twins)))
-        rows, diffs = [], []
+        rows, diffs, ses = [], [], []
         for lo, hi in zip(edges_deg[:-1], edges_deg[1:]):
             a, b = bin_mean(rr, el_deg, lo, hi), bin_mean(pooled, pel, lo, hi)
             d = b["mean"] - a["mean"] if a["mean"] is not None and b["mean"] is not None and a["n"] >= 10 else None
             if d is not None:
                 diffs.append(d)
+            se = float(np.hypot(a["se"], b["se"])) if d is not None else None
+            if d is not None:
+                ses.append(se)
             rows.append({"bin_deg": [float(lo), float(hi)], "real_dbhz": a["mean"], "real_n": a["n"],
-                         "real_se": a["se"], "twin_dbhz": b["mean"], "twin_se": b["se"], "difference": d})
-        d = np.array(diffs)
+                         "real_satellites": a["satellites"], "real_se": a["se"], "twin_dbhz": b["mean"],
+                         "twin_se": b["se"], "difference": d, "difference_se": se})
+        d, e = np.array(diffs), np.array(ses)
         out[s] = {"bins": rows, "bias_dbhz": float(d.mean()) if d.size else None,
                   "scatter_dbhz": float(d.std()) if d.size else None,
-                  "rms_dbhz": float(np.sqrt(np.mean(d ** 2))) if d.size else None}
+                  "rms_dbhz": float(np.sqrt(np.mean(d ** 2))) if d.size else None,
+                  "rms_se_dbhz": float(np.sqrt(np.mean(e ** 2))) if d.size else None,
+                  "chi2_per_bin": float(np.mean((d / e) ** 2)) if d.size and (e > 0).all() else None}
     return out
 
 
