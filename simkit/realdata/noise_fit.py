@@ -28,6 +28,7 @@ import numpy as np
 
 TOLERANCE = 0.2          # the code-noise target: twin sigma within 20 % of the real one
 CN0_TARGET_DBHZ = 1.5    # the C/N0 target: RMS over the bins
+N_EFF_MIN = 50.0         # effective values per equal-count bin: a sigma to about 1/sqrt(100) = 10 %
 
 
 def lag_one(x) -> float | None:
@@ -111,7 +112,7 @@ def bin_mean(values, el_deg, lo: float, hi: float) -> dict:
     return {"n": int(v.size), "satellites": sats, "n_eff": ne, "mean": float(v.mean()), "se": se}
 
 
-def equal_count_edges(values, el_deg, floor_deg: float, n_eff_min: float = 50.0, max_bins: int = 6) -> list:
+def equal_count_edges(values, el_deg, floor_deg: float, n_eff_min: float = N_EFF_MIN, max_bins: int = 6) -> list:
     """Elevation bin edges (deg) for ``values`` (M, S): quantiles of the elevations of its finite values, as
     many bins as keep about ``n_eff_min`` effective values each (the series' pooled lag-one autocorrelation), at
     least one and at most ``max_bins``; the outer edges ``floor_deg`` and 90."""
@@ -127,7 +128,7 @@ def equal_count_edges(values, el_deg, floor_deg: float, n_eff_min: float = 50.0,
 
 
 def code_comparison(real_mp: dict, twin_mps: list, el, floor_deg: float, edges: dict | None = None,
-                    n_eff_min: float = 50.0, max_bins: int = 6) -> dict:
+                    n_eff_min: float = N_EFF_MIN, max_bins: int = 6) -> dict:
     """Per signal: the code-noise sigma of the real file and of the twin (pooled over the realisations of
     ``twin_mps``) in equal-count elevation bins, over the satellite-epochs both have a value, with their
     uncertainties, the ratio twin / real and its relative standard error sqrt(rel_se_real^2 + rel_se_twin^2),

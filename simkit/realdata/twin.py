@@ -614,6 +614,8 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
     out_dir = Path(out_dir)
     if not nav_paths:
         raise InputError("--nav", "the twin needs the broadcast navigation file(s) of the observation file")
+    if int(realisations) < 1:
+        raise InputError("--realisations", f"expected a number of twins >= 1, got {realisations}")
     imported = importer.import_rinex(obs_path, nav_paths, reference, reference_source)
     real = real_arrays(imported)
     ref = real["reference"]
@@ -706,11 +708,65 @@ def report_markdown(fid: dict, figures=()) -> str:
         for s, v in base["real"][key].items():
             out.append(f"| {label} {s} | {_fmt(v, d)} | " + " | ".join(_fmt(fid[k]["twin"][key].get(s), d)
                                                                        for k in runs) + " |")
+    out += noise_markdown(fid)
     if "fitted_parameters" in fid:
         out += ["", "## Fitted [gnss] parameters", "", "```toml", toml_fragment(fid["fitted_parameters"]).rstrip(),
                 "```"] + [f"- {n}" for n in fid.get("fit_notes", [])]
     out += [""] + [f"![{Path(p).stem}]({Path(p).name})" for p in figures]
     return "\n".join(out) + "\n"
+
+
+def _noise_sections(fid: dict) -> list:
+    """[(title, noise check dict)] of a fitted twin: in sample and on the two out-of-sample splits."""
+    out = []
+    if "noise" in fid:
+        out.append(("in sample (the calibrated twin against the epochs it was fitted on)", fid["noise"]["in_sample"]))
+    for key in ("holdout", "holdout_interleaved"):
+        h = fid.get(key) or {}
+        if "noise" in h:
+            out.append((f"out of sample, {h['split']} split (fitted on {h['fitted_on_s'][0]:g}-{h['fitted_on_s'][1]:g} s"
+                        f"{' in alternate blocks' if h['split'] == 'interleaved' else ''}, checked on "
+                        f"{h['checked_epochs']} other epochs)", h["noise"]))
+    return out
+
+
+def noise_markdown(fid: dict) -> list:
+    """The per-bin code-noise and C/N0 tables of :func:`noise_check` with their uncertainties (report.md)."""
+    sections = _noise_sections(fid)
+    if not sections:
+        return []
+    k = fid["noise"]["twin_realisations"]
+    out = ["", "## Code noise and C/N0 with their uncertainties", "",
+           f"Equal-count elevation bins per signal (at least {noise_fit.N_EFF_MIN:g} effective values each where the data have them), the twin pooled over "
+           f"{k} realisations (seeds); code-noise model: {fid['noise']['code_model']}. ± is the relative standard "
+           "error of the ratio: the real side's the larger of 1/sqrt(2 n_eff) (n_eff from the lag-one "
+           "autocorrelation) and the jackknife over satellites. C/N0: the fixed 10-degree bins over the "
+           "satellite-epochs both track; ± the standard error of the difference."]
+    for title, sec in sections:
+        sm = sec["code_noise"]["summary"]
+        out += ["", f"### {title[0].upper()}{title[1:]}", "",
+                f"Code noise: {sm.get('within', 0)} of {sm['bins']} bins within 20 %; "
+                f"{sm.get('resolved', 0)} bins resolve 20 % (standard error <= 10 %), {sm.get('within_of_resolved', 0)} of "
+                f"them within; {sm.get('beyond_two_se', 0)} bins differ by more than two standard errors; chi-square "
+                f"per bin {_fmt(sm.get('chi2_per_bin'))}.", "",
+                "| signal | elevation (deg) | real σ (m) | n / n_eff | twin σ (m) | twin / real | ± |",
+                "|---|---|---:|---:|---:|---:|---:|"]
+        for sig, v in sec["code_noise"]["signals"].items():
+            for b in v["bins"]:
+                out.append(f"| {sig} | {b['bin_deg'][0]:.1f}-{b['bin_deg'][1]:.1f} | {_fmt(b['real_m'], 3)} | "
+                           f"{b['real_n']} / {b['real_n_eff']:.0f} | {_fmt(b['twin_m'], 3)} | {_fmt(b['ratio'])} | "
+                           f"{_fmt(b['ratio_rel_se'])} |")
+        for sig, c in sec["cn0"].items():
+            out += ["", f"C/N0 {sig}: bias {_fmt(c['bias_dbhz'])}, scatter {_fmt(c['scatter_dbhz'])}, RMS "
+                    f"{_fmt(c['rms_dbhz'])} dB-Hz over the bins (sampling alone: {_fmt(c['rms_se_dbhz'])}; chi-square "
+                    f"per bin {_fmt(c['chi2_per_bin'])})", "",
+                    "| elevation (deg) | real (dB-Hz) | satellites | twin | twin - real | ± |", "|---|---:|---:|---:|---:|---:|"]
+            for b in c["bins"]:
+                if b["difference"] is not None:
+                    out.append(f"| {b['bin_deg'][0]:g}-{b['bin_deg'][1]:g} | {_fmt(b['real_dbhz'], 1)} | "
+                               f"{b['real_satellites']} | {_fmt(b['twin_dbhz'], 1)} | {_fmt(b['difference'], 1)} | "
+                               f"{_fmt(b['difference_se'], 1)} |")
+    return out
 
 
 def _within(ratios: dict, tol: float = 0.2) -> str:
