@@ -220,6 +220,31 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
     return out
 
 
+def drift(per_signal: dict, other_mp: dict, el_other, tol: float = TOLERANCE) -> dict:
+    """The real file against itself: each bin of :func:`code_comparison`'s ``per_signal`` (the checked epochs)
+    gets the real sigma over the *other* epochs (``other_mp`` {signal: (M', S)}, elevations ``el_other`` rad,
+    e.g. the epochs a split fitted on) in the same edges and their ratio ``real_drift`` = checked / other. A
+    model of the receiver alone (one sigma per elevation) cannot follow a drift the environment makes; the
+    summary counts the bins whose real drift is within ``tol`` and beyond two standard errors."""
+    el_deg = np.degrees(el_other)
+    ratios, ses = [], []
+    for s, v in per_signal.items():
+        if s not in other_mp:
+            continue
+        for b in v["bins"]:
+            o = bin_sigma(other_mp[s], el_deg, *b["bin_deg"])
+            b["real_other_m"] = o["sigma"]
+            b["real_drift"] = b["real_m"] / o["sigma"] if o["sigma"] and b["real_m"] else None
+            if b["real_drift"]:
+                ratios.append(b["real_drift"])
+                ses.append(np.hypot(b["real_rel_se"] or 0.0, max(o["rel_se"] or 0.0, o["rel_se_satellites"] or 0.0)))
+    r, e = np.array(ratios), np.array(ses)
+    if not r.size:
+        return {"bins": 0}
+    return {"bins": int(r.size), "within": int(np.sum(np.abs(r - 1) <= tol)),
+            "beyond_two_se": int(np.sum(np.abs(np.log(r)) > 2 * e)), "median_drift": float(np.median(r))}
+
+
 def smooth_correction(per_signal: dict, current: dict, nodes_deg=tuple(range(0, 91, 10)),
                       slope_prior: float = 0.5) -> dict:
     """{signal: (elevation nodes deg, code factors)}: each signal's factor of ``current`` ({signal: number or
