@@ -498,12 +498,18 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None, c
     if not real.get("trajectory"):       # a horizon profile belongs to a fixed antenna
         hz = fit_horizon(default[1], default[2], ref, mask)
         fitted["horizon_mask"] = hz["table"]
+    code_fit = dict(fitted.get("code_error_scale", {}))
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
     if code_model == "bins":
         first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
         tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
         fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
     else:
+        # the first twin starts from the code fit itself: the default twin's code ratios belong to the default
+        # multipath profile, and dividing the fitted factors by them left factors 10x too small, where the
+        # carrier terms of the MP combination (not scaled by the factor) rule the twin's sigma and a one-step
+        # linear correction overshoots
+        fitted["code_error_scale"] = code_fit
         grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
                                     [seed + 1 + 100 * k for k in range(realisations)], path, progress)
         first = compare(grid, twins[0], ref, mask)
