@@ -94,10 +94,11 @@ def main():
                                   "rms_km": float(np.sqrt(np.nanmean(res ** 2)) / 1e3),
                                   "max_km": float(np.nanmax(np.abs(res)) / 1e3),
                                   "per_satellite_km": {sats[i]: round(float(np.nanmean(res[:, k])) / 1e3, 1)
-                                                       for k, i in enumerate(gps)}}
+                                                       for k, i in enumerate(gps) if np.isfinite(res[:, k]).any()}}
     # a satellite whose almanac range is off by more than BAD_KM (a manoeuvre since, or a PRN given to another
     # satellite) has no trustworthy elevation either: left out
-    bad = np.abs(np.nanmean(res, axis=0)) > BAD_KM * 1e3
+    n_ok = np.isfinite(res).sum(0)
+    bad = np.abs(np.nansum(res, axis=0) / np.maximum(n_ok, 1)) > BAD_KM * 1e3
     out["solo_range_residual"]["left_out"] = [sats[i] for k, i in enumerate(gps) if bad[k]]
     ok = np.abs(res[:, ~bad])
     out["solo_range_residual"]["rms_km_kept"] = float(np.sqrt(np.nanmean(ok ** 2)) / 1e3)

@@ -73,6 +73,7 @@ def test_code_comparison_pools_realisations_and_flags_a_real_mismatch():
     same = [{"L1C": 0.5 * _ar1(300, 40, 0.3, rng)} for _ in range(3)]
     s = noise_fit.code_comparison(real, same, el, 5.0, n_eff_min=500)["summary"]
     assert s["within"] == 6 and s["beyond_two_se"] <= 1 and s["chi2_per_bin"] < 3
+    assert 5.5 < s["expected_within_if_equal"] <= 6          # standard errors of a few percent: all of them
 
 
 def test_smooth_correction_removes_a_log_linear_trend_in_two_parameters():

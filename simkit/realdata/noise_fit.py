@@ -25,6 +25,7 @@ elevations (M, S) rad.
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import norm
 
 TOLERANCE = 0.2          # the code-noise target: twin sigma within 20 % of the real one
 CN0_TARGET_DBHZ = 1.5    # the C/N0 target: RMS over the bins
@@ -167,7 +168,8 @@ def code_comparison(real_mp: dict, twin_mps: list, el, floor_deg: float, edges: 
 
 
 def code_summary(per_signal: dict, tol: float = TOLERANCE) -> dict:
-    """Bins with a ratio; within ``tol``; resolved (ratio standard error <= tol / 2, so a 20 % mismatch is
+    """Bins with a ratio; within ``tol``, and how many a twin equal to the receiver in expectation would have
+    within ``tol`` given the bins' standard errors; resolved (ratio standard error <= tol / 2, so a 20 % mismatch is
     two standard errors); mismatched beyond two standard errors; median ratio; and the chi-square of
     log(ratio) against its standard errors per degree of freedom (1 = the bins agree up to sampling)."""
     rows = [b for v in per_signal.values() for b in v["bins"] if b["ratio"]]
@@ -176,7 +178,10 @@ def code_summary(per_signal: dict, tol: float = TOLERANCE) -> dict:
     ratio = np.array([b["ratio"] for b in rows])
     se = np.array([b["ratio_rel_se"] for b in rows])
     z = np.log(ratio) / se
+    # a twin equal to the receiver in expectation: log(ratio) ~ N(0, se), within tol with this probability
+    p_within = norm.cdf(np.log(1 + tol) / se) - norm.cdf(np.log(1 - tol) / se)
     return {"bins": len(rows), "within": int(np.sum(np.abs(ratio - 1) <= tol)),
+            "expected_within_if_equal": float(np.sum(p_within)),
             "resolved": int(np.sum(se <= tol / 2)),
             "within_of_resolved": int(np.sum((np.abs(ratio - 1) <= tol) & (se <= tol / 2))),
             "beyond_two_se": int(np.sum(np.abs(z) > 2)), "median_ratio": float(np.median(ratio)),

@@ -768,7 +768,8 @@ def noise_markdown(fid: dict) -> list:
     for title, sec in sections:
         sm = sec["code_noise"]["summary"]
         out += ["", f"### {title[0].upper()}{title[1:]}", "",
-                f"Code noise: {sm.get('within', 0)} of {sm['bins']} bins within 20 %; "
+                f"Code noise: {sm.get('within', 0)} of {sm['bins']} bins within 20 % (a twin equal to the receiver in "
+                f"expectation: about {_fmt(sm.get('expected_within_if_equal'), 1)} with these standard errors); "
                 f"{sm.get('resolved', 0)} bins resolve 20 % (standard error <= 10 %), {sm.get('within_of_resolved', 0)} of "
                 f"them within; {sm.get('beyond_two_se', 0)} bins differ by more than two standard errors; chi-square "
                 f"per bin {_fmt(sm.get('chi2_per_bin'))}." + _drift_line(sec["code_noise"].get("real_drift")), "",
