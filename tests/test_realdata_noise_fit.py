@@ -138,3 +138,17 @@ def test_the_satellite_jackknife_sees_the_spread_between_satellites():
             assert scatter > 2.5 * np.mean(ne)
         else:
             assert np.mean(ne) == pytest.approx(scatter, rel=0.2)
+
+
+def test_a_bin_of_one_satellite_carries_the_spread_between_satellites():
+    """Satellites with their own C/N0 offsets (sd 3 dB): the pooled spread between satellites is recovered, and a
+    bin holding one satellite gets a standard error of about that spread, however many epochs it has."""
+    rng = np.random.default_rng(4)
+    el = np.tile(np.r_[np.full(40, 20.0), 85.0], (200, 1))          # 40 satellites at 20 deg, one at 85 deg
+    cn0 = 40 + rng.normal(0, 3, 41)[None, :] + 0.2 * rng.standard_normal((200, 41))
+    edges = np.arange(0.0, 91.0, 10.0)
+    assert noise_fit.satellite_spread(cn0, el, edges) == pytest.approx(3.0, rel=0.3)
+    out = noise_fit.cn0_comparison({"L1C": cn0}, [{"L1C": np.full(cn0.shape, 40.0)}], np.radians(el), edges)
+    one = out["L1C"]["bins"][8]
+    assert one["real_satellites"] == 1 and one["real_se"] == pytest.approx(3.0, rel=0.3)
+    assert out["L1C"]["bins"][2]["real_se"] < 1.0          # 40 satellites: about 3 / sqrt(40)

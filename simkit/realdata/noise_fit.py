@@ -188,9 +188,25 @@ def code_summary(per_signal: dict, tol: float = TOLERANCE) -> dict:
             "chi2_per_bin": float(np.mean(z ** 2)), "median_ratio_rel_se": float(np.median(se))}
 
 
+def satellite_spread(values, el_deg, edges_deg) -> float | None:
+    """Standard deviation (the values' unit) of the satellites' means about their elevation bin's mean, pooled
+    over the bins that hold two or more satellites: the spread a bin's mean has from which satellites are in
+    it (their power, and at a street their shadowing), whatever its number of epochs; None without such a bin."""
+    num = dof = 0.0
+    for lo, hi in zip(edges_deg[:-1], edges_deg[1:]):
+        x = _in_bin(values, el_deg, lo, hi)
+        n = np.isfinite(x).sum(0)
+        m = np.nansum(x, 0)[n > 0] / n[n > 0]
+        if m.size >= 2:
+            num += float(np.sum((m - m.mean()) ** 2))
+            dof += m.size - 1
+    return float(np.sqrt(num / dof)) if dof else None
+
+
 def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
     """Per signal: mean C/N0 (dB-Hz) of real and twin (pooled over realisations) per elevation bin over the
-    satellite-epochs both track, with standard errors (:func:`bin_mean`), and the difference twin - real split
+    satellite-epochs both track, with standard errors (:func:`bin_mean`; the real side's at least the
+    :func:`satellite_spread` over sqrt(satellites in the bin)), and the difference twin - real split
     into its bias (mean over bins), scatter (std over bins) and RMS; ``rms_se_dbhz`` the RMS of the differences'
     standard errors (the RMS that sampling alone would give) and ``chi2_per_bin`` the mean squared difference in
     standard errors (about 1 when the bins differ by sampling only)."""
@@ -205,8 +221,11 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
         pooled = np.concatenate([np.where(b, t, np.nan) for b, t in zip(both, twins)], axis=1)
         pel = np.tile(el_deg, (1, len(twins)))
         rows, diffs, ses = [], [], []
+        between = satellite_spread(rr, el_deg, edges_deg)
         for lo, hi in zip(edges_deg[:-1], edges_deg[1:]):
             a, b = bin_mean(rr, el_deg, lo, hi), bin_mean(pooled, pel, lo, hi)
+            if a["se"] is not None and between is not None:     # a bin of one or two satellites
+                a["se"] = max(a["se"], between / np.sqrt(a["satellites"]))
             d = b["mean"] - a["mean"] if a["mean"] is not None and b["mean"] is not None and a["n"] >= 10 else None
             if d is not None:
                 diffs.append(d)
