@@ -199,3 +199,17 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
             assert c["rms_se_dbhz"] > 0
     fragment = tomllib.loads((out / "fitted.toml").read_text())
     assert "gain_pattern" in fragment["gnss"]["antenna"][0] and "environment" not in fragment
+
+
+def test_twin_refuses_no_realisations_and_an_unknown_code_model(tmp_path, capsys):
+    assert main(["twin", str(KMS3_OBS), "--nav", str(KMS3_NAV), "-o", str(tmp_path / "t"), "--no-plots",
+                 "--realisations", "0"]) == 2
+    assert "--realisations" in capsys.readouterr().err
+    assert not (tmp_path / "t" / "fidelity.json").exists()
+    with pytest.raises(SystemExit):
+        main(["twin", str(KMS3_OBS), "--nav", str(KMS3_NAV), "-o", str(tmp_path / "u"), "--code-model", "spline"])
+    from simkit.errors import InputError
+
+    with pytest.raises(InputError, match="code_model"):
+        twin._calibrate({}, None, [], 0.0, 1, tmp_path / "x.h5", False, default=(None, None, None),
+                        code_model="spline")
