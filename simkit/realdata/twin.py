@@ -612,6 +612,30 @@ def level_track_csv(rec, centre, name: str) -> str:
                       "gps_week,gps_sow,lat_deg,lon_deg,h_m,sd_e_m,sd_n_m,sd_u_m", *rows]) + "\n"
 
 
+def _fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress, default, code_model, realisations) -> dict:
+    """--fit of :func:`run_twin`: the calibrated twin (fitted.toml, twin_fit.h5), its comparison and noise checks in
+    sample, and the two out-of-sample splits; the entries of the fidelity dict."""
+    result = {}
+    fitted, notes, extras = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5", progress,
+                                       default, code_model, realisations)
+    result.update(extras)
+    result["fit_notes"] = notes
+    result["fitted_parameters"] = fitted
+    (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
+    # the last realisation written (twin_fit.h5) is the seed + 2 twin of the fixed-bin comparison
+    grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
+                                [seed + 2 + 100 * k for k in reversed(range(realisations))],
+                                out_dir / "twin_fit.h5", progress)
+    result["fitted"] = compare(grid, twins[-1], ref, mask)
+    result["noise"] = {"in_sample": noise_check(grid, twins, ref, mask), "code_model": code_model,
+                       "twin_realisations": realisations}
+    result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress,
+                                 "half", code_model, realisations)
+    result["holdout_interleaved"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5",
+                                             progress, "interleaved", code_model, realisations)
+    return result
+
+
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
              reference_source=None, progress: bool = False, trajectory=None, trajectory_solution=None,
              code_model: str = "smooth", realisations: int = REALISATIONS) -> dict:
@@ -657,23 +681,8 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
     result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
                                                       out_dir / "twin.h5", progress, arrays=True)
     if fit:
-        fitted, notes, extras = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5", progress,
-                                           (result["default"], real_grid, twin0), code_model, realisations)
-        result.update(extras)
-        result["fit_notes"] = notes
-        result["fitted_parameters"] = fitted
-        (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
-        # the last realisation written (twin_fit.h5) is the seed + 2 twin of the fixed-bin comparison
-        grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
-                                    [seed + 2 + 100 * k for k in reversed(range(realisations))],
-                                    out_dir / "twin_fit.h5", progress)
-        result["fitted"] = compare(grid, twins[-1], ref, mask)
-        result["noise"] = {"in_sample": noise_check(grid, twins, ref, mask), "code_model": code_model,
-                           "twin_realisations": realisations}
-        result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress,
-                                     "half", code_model, realisations)
-        result["holdout_interleaved"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5",
-                                                 progress, "interleaved", code_model, realisations)
+        result.update(_fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress,
+                                     (result["default"], real_grid, twin0), code_model, realisations))
     (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
     return result
 
