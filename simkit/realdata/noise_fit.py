@@ -28,7 +28,6 @@ import numpy as np
 from scipy.stats import norm
 
 TOLERANCE = 0.2          # the code-noise target: twin sigma within 20 % of the real one
-CN0_TARGET_DBHZ = 1.5    # the C/N0 target: RMS over the bins
 N_EFF_MIN = 50.0         # effective values per equal-count bin: a sigma to about 1/sqrt(100) = 10 %
 
 
