@@ -118,8 +118,25 @@ def test_twin_of_kms3_with_fit(tmp_path, capsys):
     ratios["holdout"] = [x for v in fid["holdout"]["code_noise_ratio"].values() for x in v if x]
     assert np.median(ratios["default"]) > 2.0                      # simkit's defaults: a noisier receiver
     assert 0.85 < np.median(ratios["fitted"]) < 1.15                # the calibrated twin, in sample
-    assert np.mean([abs(x - 1) <= 0.2 for x in ratios["fitted"]]) > 0.6
     assert 0.8 < np.median(ratios["holdout"]) < 1.3                 # out of sample
+    # the equal-count bins with their standard errors (twin over 4 seeds): in sample the ratios scatter about 1 as
+    # their standard errors say; out of sample on both splits no more than sampling and a few bins beyond two
+    # standard errors (KMS3's 9 minutes: no bin resolves 20 %, noted in docs/real_data.md)
+    ins = fid["noise"]["in_sample"]["code_noise"]
+    assert ins["twin_realisations"] == 4 and "G1C" not in ins["signals"]        # GLONASS FDMA left out
+    sm = ins["summary"]
+    assert sm["bins"] >= 20 and sm["chi2_per_bin"] < 1.5 and 0.9 < sm["median_ratio"] < 1.1
+    assert sm["within"] >= sm["expected_within_if_equal"] - 3
+    for b in (b for v in ins["signals"].values() for b in v["bins"]):
+        assert b["real_rel_se"] >= b["real_rel_se_series"] > 0 and b["twin_n_eff"] > 2 * b["real_n_eff"]
+    for key, split in (("holdout", "half"), ("holdout_interleaved", "interleaved")):
+        h = fid[key]
+        assert h["split"] == split and h["code_model"] == "smooth"
+        sm = h["noise"]["code_noise"]["summary"]
+        assert sm["chi2_per_bin"] < 3.0 and 0.8 < sm["median_ratio"] < 1.25 and sm["beyond_two_se"] <= 3
+        assert h["noise"]["code_noise"]["real_drift"]["bins"] == sm["bins"]
+    assert fid["holdout_interleaved"]["checked_epochs"] == 6          # 19 epochs: blocks of 6-7, the middle one
+    assert "twin equal to the receiver" in report and "Out of sample, interleaved split" in report
     fragment = tomllib.loads((out / "fitted.toml").read_text())
     assert set(fragment["gnss"]["code_error_scale"]) == set(fid["signals"])
     assert len(fragment["environment"]["body_mask"][0]["azimuth_deg"]) == 72
@@ -205,5 +222,26 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
         return np.sqrt(np.mean(np.square(list(fid[run]["cn0_rms_difference_dbhz"].values()))))
     assert set(fid["fitted"]["cn0_rms_difference_dbhz"]) == {"L1C", "G1C"}
     assert rms("fitted") < 0.75 * rms("default")
+    # the noise checks: C/N0 of both systems with their standard errors, code noise of GPS only (FDMA left out)
+    for key in ("holdout", "holdout_interleaved"):
+        n = fid[key]["noise"]
+        assert set(n["cn0"]) == {"L1C", "G1C"} and set(n["code_noise"]["signals"]) == {"L1C"}
+        for c in n["cn0"].values():
+            assert c["rms_dbhz"] ** 2 == pytest.approx(c["bias_dbhz"] ** 2 + c["scatter_dbhz"] ** 2)
+            assert c["rms_se_dbhz"] > 0
     fragment = tomllib.loads((out / "fitted.toml").read_text())
     assert "gain_pattern" in fragment["gnss"]["antenna"][0] and "environment" not in fragment
+
+
+def test_twin_refuses_no_realisations_and_an_unknown_code_model(tmp_path, capsys):
+    assert main(["twin", str(KMS3_OBS), "--nav", str(KMS3_NAV), "-o", str(tmp_path / "t"), "--no-plots",
+                 "--realisations", "0"]) == 2
+    assert "--realisations" in capsys.readouterr().err
+    assert not (tmp_path / "t" / "fidelity.json").exists()
+    with pytest.raises(SystemExit):
+        main(["twin", str(KMS3_OBS), "--nav", str(KMS3_NAV), "-o", str(tmp_path / "u"), "--code-model", "spline"])
+    from simkit.errors import InputError
+
+    with pytest.raises(InputError, match="code_model"):
+        twin._calibrate({}, None, [], 0.0, 1, tmp_path / "x.h5", False, default=(None, None, None),
+                        code_model="spline")

@@ -23,6 +23,10 @@ def add_parser(sub):
                    "source: CSV, NMEA, GPX, KML, or a simkit file's /solutions, e.g. the real file's SPP)")
     p.add_argument("--trajectory-solution", metavar="NAME", help="the /solutions group of an .h5 --trajectory")
     p.add_argument("--seed", type=int, default=1, help="seed of the twin (default 1)")
+    p.add_argument("--code-model", choices=("smooth", "bins"), default="smooth",
+                   help="--fit's code-noise correction: a line in elevation per signal (default) or a factor per bin")
+    p.add_argument("--realisations", type=int, default=4, metavar="N",
+                   help="twins (seeds) pooled for the twin's code noise and C/N0 in the checks (default 4)")
     p.add_argument("--no-plots", action="store_true", help="no figures (they need the 'plot' extra)")
     return p
 
@@ -44,7 +48,8 @@ def run(args) -> int:
     reference, source = importer.parse_reference(args.reference, None)
     fid = twin.run_twin(args.obs, args.nav, out, fit=args.fit, seed=args.seed, reference=reference,
                         reference_source=source, trajectory=args.trajectory,
-                        trajectory_solution=args.trajectory_solution)
+                        trajectory_solution=args.trajectory_solution, code_model=args.code_model,
+                        realisations=args.realisations)
     figures = []
     if not args.no_plots:
         from ..plots import twin_figures

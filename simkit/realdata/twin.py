@@ -24,7 +24,7 @@ from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
 from ..gnss.config import code_scale_at
-from . import acquisition, fidelity, horizon, importer, ionosphere, sisre
+from . import acquisition, fidelity, horizon, importer, ionosphere, noise_fit, sisre
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -243,7 +243,11 @@ def fit_parameters(real: dict, reference) -> dict:
         notes.append("too few code-minus-carrier bins: code noise and multipath left at the defaults")
     else:
         p["mp_code_sigma_m"], p["mp_elevation_scale_deg"], p["code_error_scale"] = code
-    rho = _lag_one(st["_series"]["mp"])
+    # the median over signals: a few metre-level series (GLONASS, formed with nominal frequencies) would rule a
+    # pooled estimate
+    rhos = [noise_fit.lag_one(v) for s, v in st["_series"]["mp"].items() if not sigmod.get(s).is_fdma]
+    rhos = [r for r in rhos if r is not None]
+    rho = float(np.median(rhos)) if rhos else None
     if rho is not None and 0.0 < rho < 1.0:
         p["mp_correlation_time_s"] = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0))
     rates = [v for v in st["slips_per_hour"].values() if v is not None]
@@ -388,17 +392,6 @@ def _fit_code(st, sigs, centres, dll):
             {sigs[k].name: float(np.exp(x[2 + i])) for i, k in enumerate(used)})
 
 
-def _lag_one(series: dict):
-    """Pooled lag-one autocorrelation of the multipath series (pairs of consecutive finite values)."""
-    num = den = 0.0
-    for x in series.values():
-        a, b = x[:-1], x[1:]
-        ok = np.isfinite(a) & np.isfinite(b)
-        num += float(np.sum(a[ok] * b[ok]))
-        den += float(np.sum(a[ok] ** 2))
-    return num / den if den > 0 else None
-
-
 def toml_fragment(p: dict) -> str:
     """The fitted parameters as the [gnss] TOML fragment of a scenario (the calibrated twin)."""
     lines = ["# simkit twin --fit: [gnss] error parameters estimated from the real file (docs/real_data.md)", "[gnss]",
@@ -453,13 +446,40 @@ def _scale_toml(v) -> str:
 
 
 def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress, arrays=False):
+    """One twin of ``real`` with ``params``: its comparison (and the real arrays on its grid and its own). The twin
+    keeps only the epochs the real arrays have (``real`` may be a subset of a file's epochs: a split)."""
     from ..pipeline import run
 
     run(scenario(real, ref, nav_paths, mask, params, seed), out=path, progress=progress, force=True)
     twin = file_arrays(path)
+    twin = _rows(twin, _align(real, twin)[1] >= 0)
     on_grid = on_twin_grid(real, twin)
     result = compare(on_grid, twin, ref, mask)
     return (result, on_grid, twin) if arrays else result
+
+
+def _realisations(real, ref, nav_paths, mask, params, seeds, path, progress):
+    """Twins of ``real`` with ``params`` for each of ``seeds``: (the real arrays on their grid, [twin arrays])."""
+    runs = [_twin_once(real, ref, nav_paths, mask, params, s, path, progress, arrays=True) for s in seeds]
+    return runs[0][1], [r[2] for r in runs]
+
+
+def noise_check(real_grid: dict, twins: list, ref, mask: float, rows=None) -> dict:
+    """:func:`.noise_fit.code_comparison` (equal-count bins, twin over its realisations) and
+    :func:`.noise_fit.cn0_comparison` (the fixed bins) of the real arrays on the twins' grid against ``twins``,
+    on the epochs ``rows`` (bool; all when None)."""
+    if rows is not None:
+        real_grid, twins = _rows(real_grid, rows), [_rows(t, rows) for t in twins]
+    el = fidelity.elevations(twins[0]["sat_pos"], ref)
+
+    def mp(a):   # FDMA (GLONASS): an imported file carries each signal's nominal frequency only, no channel
+        out = fidelity.multipath(a["obs"], a["signals"], np.asarray(a["freq"]), a["t"])
+        return {s: v for s, v in out.items() if not sigmod.get(s).is_fdma}
+
+    code = noise_fit.code_comparison(mp(real_grid), [mp(t) for t in twins], el, mask)
+    cn0 = noise_fit.cn0_comparison(real_grid["obs"]["cn0"], [t["obs"]["cn0"] for t in twins], el,
+                                   fidelity.ELEVATION_EDGES_DEG)
+    return {"code_noise": code, "cn0": cn0, "epochs": int(twins[0]["t"].size)}
 
 
 def fit_horizon(real_on_grid: dict, twin: dict, reference, mask_deg: float) -> dict:
@@ -490,12 +510,23 @@ def fit_acquisition(real_on_grid: dict, twin: dict, reference, mask_deg: float, 
     return out
 
 
-def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
+REALISATIONS = 4          # twins (seeds) whose pooled statistics are the twin's expectation in a noise check
+CODE_MODELS = ("smooth", "bins")
+
+
+def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None, code_model="smooth",
+               realisations=REALISATIONS):
     """The fitted parameters of ``real`` (:func:`fit_parameters`, the horizon profile, then the carrier, Doppler
-    and code terms scaled from a default and a first calibrated twin, and the code factors made tables over
-    elevation), the fit's notes and {"horizon": :func:`fit_horizon`, "ionosphere": the Klobuchar comparison of
-    :func:`.ionosphere.klobuchar_ratio`}; ``default`` = (comparison, real on the grid, twin arrays)
-    of a default twin already run on ``real``."""
+    and code terms scaled from a default and a first calibrated twin), the fit's notes and {"horizon":
+    :func:`fit_horizon`, "ionosphere": the Klobuchar comparison of :func:`.ionosphere.klobuchar_ratio`};
+    ``default`` = (comparison, real on the grid, twin arrays) of a default twin already run on ``real``.
+
+    ``code_model``: "smooth" (the code factor per signal corrected by a line in elevation through the log
+    twin / real ratios of ``realisations`` first twins in equal-count bins, :func:`.noise_fit.smooth_correction`:
+    two parameters per signal) or "bins" (a free factor per 10-degree bin from one first twin,
+    :func:`code_tables`)."""
+    if code_model not in CODE_MODELS:
+        raise InputError("code_model", f"expected one of {', '.join(CODE_MODELS)}, got {code_model!r}")
     if default is None:
         default = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed, path, progress, arrays=True)
     fitted = fit_parameters(real, ref)
@@ -509,10 +540,25 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None):
     acq = fit_acquisition(default[1], default[2], ref, mask, hz["table"] if hz else None)
     if acq["delay_s"] > 0:
         fitted["acquisition"] = {"delay_s": acq["delay_s"]}
+    code_fit = dict(fitted.get("code_error_scale", {}))
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
-    first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
-    tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
-    fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
+    if code_model == "bins":
+        first = _twin_once(real, ref, nav_paths, mask, fitted, seed + 1, path, progress)
+        tables = code_tables(fitted, first)["code_error_scale"]    # code factors per elevation bin
+        fitted = {**rescale(fitted, first), "code_error_scale": tables}   # carrier and Doppler refined
+    else:
+        # the first twin starts from the code fit itself: the default twin's code ratios belong to the default
+        # multipath profile, and dividing the fitted factors by them left factors 10x too small, where the
+        # carrier terms of the MP combination (not scaled by the factor) rule the twin's sigma and a one-step
+        # linear correction overshoots
+        fitted["code_error_scale"] = code_fit
+        grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
+                                    [seed + 1 + 100 * k for k in range(realisations)], path, progress)
+        first = compare(grid, twins[0], ref, mask)
+        code = noise_check(grid, twins, ref, mask)["code_noise"]["signals"]
+        tables = noise_fit.smooth_correction(code, fitted.get("code_error_scale", {}))
+        fitted = rescale(fitted, first)
+        fitted["code_error_scale"] = {**fitted["code_error_scale"], **tables}
     return fitted, notes, {"horizon": hz, "ionosphere": iono, "sisre_troposphere": range_errors, "acquisition": acq}
 
 
@@ -523,28 +569,59 @@ def _rows(arr: dict, rows) -> dict:
             "obs": {k: {s: v[rows] for s, v in d.items()} for k, d in arr["obs"].items()}}
 
 
-def _holdout(real, ref, nav_paths, mask, seed, path, progress) -> dict:
-    """Out-of-sample check of the fit: every parameter (horizon profile and code tables included) fitted on the
-    first half of the epochs only, a twin of the whole span run with them, and the comparison on the second half
-    (neither the fit nor its twins saw it)."""
-    first_half = real["t"] < real["t"][0] + 0.5 * (real["t"][-1] - real["t"][0])
-    fitted, _, extras = _calibrate(_rows(real, first_half), ref, nav_paths, mask, seed + 10, path, progress)
-    from ..pipeline import run
+SPLITS = ("half", "interleaved")
+MAX_BLOCKS = 6
 
-    run(scenario(real, ref, nav_paths, mask, fitted, seed + 12), out=path, progress=progress, force=True)
-    twin = file_arrays(path)
-    grid = on_twin_grid(real, twin)
-    second = twin["t"] >= real["t"][~first_half][0] - 1e-6
-    out = compare(_rows(grid, second), _rows(twin, second), ref, mask)
-    return {"fitted_on_s": [float(real["t"][first_half][0]), float(real["t"][first_half][-1])],
-            "checked_on_s": [float(twin["t"][second][0]), float(twin["t"][second][-1])],
+
+def split_rows(t, kind: str):
+    """The epochs (bool (M,)) a split fits on; the others are checked. "half": the first half of the span.
+    "interleaved": the span cut into equal blocks, as many as leave each block at least ``fidelity.MIN_ARC`` + 1
+    epochs (at most ``MAX_BLOCKS``, at least 3), fitted on the even blocks and checked on the odd ones: along a
+    drive the environment changes, and a first / second half split mixes that change with the model's error."""
+    t = np.asarray(t, float)
+    span = t[-1] - t[0]
+    if kind == "half":
+        return t < t[0] + 0.5 * span
+    if kind != "interleaved":
+        raise InputError("split", f"expected one of {', '.join(SPLITS)}, got {kind!r}")
+    n = int(np.clip(t.size // (fidelity.MIN_ARC + 1), 3, MAX_BLOCKS))
+    block = np.minimum(np.floor((t - t[0]) / span * n), n - 1) if span > 0 else np.zeros(t.size)
+    return block % 2 == 0
+
+
+def _holdout(real, ref, nav_paths, mask, seed, path, progress, split="half", code_model="smooth",
+             realisations=REALISATIONS) -> dict:
+    """Out-of-sample check of the fit: every parameter (horizon profile and code tables included) fitted on the
+    epochs :func:`split_rows` keeps, twins of the whole span run with them (``realisations`` seeds), and the
+    comparison on the other epochs (neither the fit nor its twins saw them)."""
+    fit_rows = split_rows(real["t"], split)
+    fitted, _, extras = _calibrate(_rows(real, fit_rows), ref, nav_paths, mask, seed + 10, path, progress,
+                                   code_model=code_model, realisations=realisations)
+    grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
+                                [seed + 12 + 100 * k for k in range(realisations)], path, progress)
+    check = ~fit_rows[np.clip(_align(real, twins[0])[1], 0, None)]
+    out = compare(_rows(grid, check), _rows(twins[0], check), ref, mask)
+    tc = twins[0]["t"]
+    return {"split": split, "code_model": code_model,
+            "fitted_on_s": [float(x) for x in real["t"][fit_rows][[0, -1]]],
+            "checked_on_s": [float(x) for x in tc[check][[0, -1]]], "checked_epochs": int(check.sum()),
             "visibility_agreement": out["visibility_agreement"],
             "satellite_epochs_above_mask": out["satellite_epochs_above_mask"],
             "tracked_real_not_twin": out["tracked_real_not_twin"], "tracked_twin_not_real": out["tracked_twin_not_real"],
             "code_noise_ratio": out["code_noise_ratio"], "real_code_noise_m": out["real"]["code_noise_m"],
             "cn0_rms_difference_dbhz": out["cn0_rms_difference_dbhz"],
             "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": (extras["horizon"] or {}).get("table"),
-            "iono_residual_fraction": fitted.get("iono_residual_fraction")}
+            "iono_residual_fraction": fitted.get("iono_residual_fraction"),
+            "noise": _with_drift(noise_check(grid, twins, ref, mask, rows=check), _rows(grid, ~check), ref)}
+
+
+def _with_drift(check: dict, other: dict, ref) -> dict:
+    """``check`` (a :func:`noise_check` on some epochs) with the real file's own drift against the ``other``
+    epochs (:func:`.noise_fit.drift`)."""
+    mp = fidelity.multipath(other["obs"], other["signals"], np.asarray(other["freq"]), other["t"])
+    el = fidelity.elevations(other["sat_pos"], ref)
+    check["code_noise"]["real_drift"] = noise_fit.drift(check["code_noise"]["signals"], mp, el)
+    return check
 
 
 def track_sigma_enu(pos_ecef, centre, window: int = 51) -> list:
@@ -578,18 +655,49 @@ def level_track_csv(rec, centre, name: str) -> str:
                       "gps_week,gps_sow,lat_deg,lon_deg,h_m,sd_e_m,sd_n_m,sd_u_m", *rows]) + "\n"
 
 
+def _fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress, default, code_model, realisations) -> dict:
+    """--fit of :func:`run_twin`: the calibrated twin (fitted.toml, twin_fit.h5), its comparison and noise checks in
+    sample, and the two out-of-sample splits; the entries of the fidelity dict."""
+    result = {}
+    fitted, notes, extras = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5", progress,
+                                       default, code_model, realisations)
+    result.update(extras)
+    result["fit_notes"] = notes
+    result["fitted_parameters"] = fitted
+    (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
+    # the last realisation written (twin_fit.h5) is the seed + 2 twin of the fixed-bin comparison
+    grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
+                                [seed + 2 + 100 * k for k in reversed(range(realisations))],
+                                out_dir / "twin_fit.h5", progress)
+    result["fitted"] = compare(grid, twins[-1], ref, mask)
+    result["noise"] = {"in_sample": noise_check(grid, twins, ref, mask), "code_model": code_model,
+                       "twin_realisations": realisations}
+    result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress,
+                                 "half", code_model, realisations)
+    result["holdout_interleaved"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5",
+                                             progress, "interleaved", code_model, realisations)
+    return result
+
+
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
-             reference_source=None, progress: bool = False, trajectory=None, trajectory_solution=None) -> dict:
+             reference_source=None, progress: bool = False, trajectory=None, trajectory_solution=None,
+             code_model: str = "smooth", realisations: int = REALISATIONS) -> dict:
     """Import ``obs_path`` (+ ``nav_paths``), simulate its twin into ``out_dir``/twin.h5 (and with ``fit`` the
     calibrated twin_fit.h5), compare; returns the fidelity dict (also the content of fidelity.json).
 
     ``trajectory``: a log of the receiver's path (any ``[trajectory] source``: e.g. the real file's own SPP
     solution, ``real.h5`` with ``trajectory_solution="spp"``): the twin of a moving receiver. Its outlying
     samples are dropped (``outliers = "drop"``); elevations for the statistics are taken from the log's median
-    position (a car's few hundred metres move them by less than 0.01 deg) and no horizon profile is fitted."""
+    position (a car's few hundred metres move them by less than 0.01 deg) and no horizon profile is fitted.
+
+    ``code_model`` and ``realisations``: :func:`_calibrate`'s; the calibrated twin is checked in sample and out of
+    sample on both :data:`SPLITS` (``holdout``: half, ``holdout_interleaved``) over ``realisations`` seeds
+    (:func:`noise_check`)."""
     out_dir = Path(out_dir)
     if not nav_paths:
         raise InputError("--nav", "the twin needs the broadcast navigation file(s) of the observation file")
+    if int(realisations) < 1:
+        raise InputError("--realisations", f"expected a number of twins >= 1, got {realisations}")
     imported = importer.import_rinex(obs_path, nav_paths, reference, reference_source)
     real = real_arrays(imported)
     ref = real["reference"]
@@ -616,15 +724,8 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
     result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
                                                       out_dir / "twin.h5", progress, arrays=True)
     if fit:
-        fitted, notes, extras = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5", progress,
-                                           (result["default"], real_grid, twin0))
-        result.update(extras)
-        result["fit_notes"] = notes
-        result["fitted_parameters"] = fitted
-        (out_dir / "fitted.toml").write_text(toml_fragment(fitted))
-        result["fitted"] = _twin_once(real, ref, nav_paths, mask, fitted, seed + 2, out_dir / "twin_fit.h5",
-                                      progress)
-        result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress)
+        result.update(_fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress,
+                                     (result["default"], real_grid, twin0), code_model, realisations))
     (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
     return result
 
@@ -674,12 +775,75 @@ def report_markdown(fid: dict, figures=()) -> str:
         for s, v in base["real"][key].items():
             out.append(f"| {label} {s} | {_fmt(v, d)} | " + " | ".join(_fmt(fid[k]["twin"][key].get(s), d)
                                                                        for k in runs) + " |")
+    out += noise_markdown(fid)
     if "fitted_parameters" in fid:
         out += ["", "## Fitted [gnss] parameters", "", "```toml", toml_fragment(fid["fitted_parameters"]).rstrip(),
                 "```"] + [f"- {n}" for n in fid.get("fit_notes", [])]
     out += sisre.report_lines(fid.get("sisre_troposphere")) + acquisition.report_lines(fid.get("acquisition"))
     out += [""] + [f"![{Path(p).stem}]({Path(p).name})" for p in figures]
     return "\n".join(out) + "\n"
+
+
+def _noise_sections(fid: dict) -> list:
+    """[(title, noise check dict)] of a fitted twin: in sample and on the two out-of-sample splits."""
+    out = []
+    if "noise" in fid:
+        out.append(("in sample (the calibrated twin against the epochs it was fitted on)", fid["noise"]["in_sample"]))
+    for key in ("holdout", "holdout_interleaved"):
+        h = fid.get(key) or {}
+        if "noise" in h:
+            out.append((f"out of sample, {h['split']} split (fitted on {h['fitted_on_s'][0]:g}-{h['fitted_on_s'][1]:g} s"
+                        f"{' in alternate blocks' if h['split'] == 'interleaved' else ''}, checked on "
+                        f"{h['checked_epochs']} other epochs)", h["noise"]))
+    return out
+
+
+def _drift_line(d) -> str:
+    if not d or not d.get("bins"):
+        return ""
+    return (f" The real file against itself (its sigma on these epochs over its sigma on the epochs fitted on, same "
+            f"bins): {d['within']} of {d['bins']} bins within 20 %, {d['beyond_two_se']} beyond two standard "
+            f"errors, median {_fmt(d['median_drift'])}.")
+
+
+def noise_markdown(fid: dict) -> list:
+    """The per-bin code-noise and C/N0 tables of :func:`noise_check` with their uncertainties (report.md)."""
+    sections = _noise_sections(fid)
+    if not sections:
+        return []
+    k = fid["noise"]["twin_realisations"]
+    out = ["", "## Code noise and C/N0 with their uncertainties", "",
+           f"Equal-count elevation bins per signal (at least {noise_fit.N_EFF_MIN:g} effective values each where the data have them), the twin pooled over "
+           f"{k} realisations (seeds); code-noise model: {fid['noise']['code_model']}. ± is the relative standard "
+           "error of the ratio: the real side's the larger of 1/sqrt(2 n_eff) (n_eff from the lag-one "
+           "autocorrelation) and the jackknife over satellites. C/N0: the fixed 10-degree bins over the "
+           "satellite-epochs both track; ± the standard error of the difference."]
+    for title, sec in sections:
+        sm = sec["code_noise"]["summary"]
+        out += ["", f"### {title[0].upper()}{title[1:]}", "",
+                f"Code noise: {sm.get('within', 0)} of {sm['bins']} bins within 20 % (a twin equal to the receiver in "
+                f"expectation: about {_fmt(sm.get('expected_within_if_equal'), 1)} with these standard errors); "
+                f"{sm.get('resolved', 0)} bins resolve 20 % (standard error <= 10 %), {sm.get('within_of_resolved', 0)} of "
+                f"them within; {sm.get('beyond_two_se', 0)} bins differ by more than two standard errors; chi-square "
+                f"per bin {_fmt(sm.get('chi2_per_bin'))}." + _drift_line(sec["code_noise"].get("real_drift")), "",
+                "| signal | elevation (deg) | real σ (m) | n / n_eff | twin σ (m) | twin / real | ± |",
+                "|---|---|---:|---:|---:|---:|---:|"]
+        for sig, v in sec["code_noise"]["signals"].items():
+            for b in v["bins"]:
+                out.append(f"| {sig} | {b['bin_deg'][0]:.1f}-{b['bin_deg'][1]:.1f} | {_fmt(b['real_m'], 3)} | "
+                           f"{b['real_n']} / {b['real_n_eff']:.0f} | {_fmt(b['twin_m'], 3)} | {_fmt(b['ratio'])} | "
+                           f"{_fmt(b['ratio_rel_se'])} |")
+        for sig, c in sec["cn0"].items():
+            out += ["", f"C/N0 {sig}: bias {_fmt(c['bias_dbhz'])}, scatter {_fmt(c['scatter_dbhz'])}, RMS "
+                    f"{_fmt(c['rms_dbhz'])} dB-Hz over the bins (sampling alone: {_fmt(c['rms_se_dbhz'])}; chi-square "
+                    f"per bin {_fmt(c['chi2_per_bin'])})", "",
+                    "| elevation (deg) | real (dB-Hz) | satellites | twin | twin - real | ± |", "|---|---:|---:|---:|---:|---:|"]
+            for b in c["bins"]:
+                if b["difference"] is not None:
+                    out.append(f"| {b['bin_deg'][0]:g}-{b['bin_deg'][1]:g} | {_fmt(b['real_dbhz'], 1)} | "
+                               f"{b['real_satellites']} | {_fmt(b['twin_dbhz'], 1)} | {_fmt(b['difference'], 1)} | "
+                               f"{_fmt(b['difference_se'], 1)} |")
+    return out
 
 
 def _within(ratios: dict, tol: float = 0.2) -> str:
