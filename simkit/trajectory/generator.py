@@ -18,12 +18,11 @@ from __future__ import annotations
 from typing import Iterator
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .. import earth, frames
 from ..earth import G0
 from .config import TrajectoryConfig
-from .truth import TrajectoryTruth, body_rate_nb
+from .truth import TrajectoryTruth, body_rate_nb, body_truth
 
 CHANNELS = ("accel", "pitch_rate", "turn_rate", "turn_accel", "roll_rate")
 
@@ -140,15 +139,12 @@ class Trajectory:
                    + (speed * gamma_dot)[:, None] * np.stack([-sg * sp, -sg * cp, cg], -1)
                    + (speed * psi_dot)[:, None] * np.stack([cg * cp, -cg * sp, np.zeros_like(t)], -1))
 
-        rot = Rotation.from_quat(frames.quat_from_euler(gamma, roll, psi))
         w_nb = body_rate_nb(gamma, roll, gamma_dot, roll_dot, psi_dot)
         w_ie = earth.earth_rate_enu(lat)
         w_en = earth.transport_rate_enu(lat, hgt, vel_enu)
-        omega_ib_b = w_nb + rot.inv().apply(w_ie + w_en)
         f_n = acc_enu + np.cross(2.0 * w_ie + w_en, vel_enu) - earth.gravity_enu(lat, hgt)
-        f_ib_b = rot.inv().apply(f_n)
+        quat_nb, euler, omega_ib_b, f_ib_b = body_truth(gamma, roll, psi, w_nb, w_ie + w_en, f_n)
 
         pos_lla = np.stack([lat, lon, hgt], axis=-1)
         return TrajectoryTruth(t=t, pos_ecef=frames.lla_to_ecef(lat, lon, hgt), pos_lla=pos_lla, vel_enu=vel_enu,
-                     quat_nb=rot.as_quat(), euler=frames.euler_from_attitude(rot), omega_ib_b=omega_ib_b,
-                     f_ib_b=f_ib_b)
+                               quat_nb=quat_nb, euler=euler, omega_ib_b=omega_ib_b, f_ib_b=f_ib_b)

@@ -44,3 +44,29 @@ def body_rate_nb(pitch, roll, pitch_dot, roll_dot, heading_dot) -> np.ndarray:
     return np.stack([cr * pitch_dot - sr * cp * yaw_dot,
                      np.sin(pitch) * yaw_dot + roll_dot,
                      sr * pitch_dot + cr * cp * yaw_dot], axis=-1)
+
+
+def body_truth(pitch, roll, heading, w_nb_b, w_in_n, f_n):
+    """The attitude and the body-frame truth of C_b^n = R_z(-heading) R_x(pitch) R_y(roll), from the angles (N,)
+    rad of any range (a loop's pitch passes 90 deg): ``quat_nb`` (N, 4) scalar-last, unit; ``euler`` (N, 3)
+    [pitch in [-pi/2, pi/2], roll in (-pi, pi], heading in [0, 2 pi)] rad, the same attitude; ``omega_ib_b`` =
+    ``w_nb_b`` + C_n^b ``w_in_n`` and ``f_ib_b`` = C_n^b ``f_n`` (N, 3), rad/s and m/s^2.
+
+    The matrix is written out from the angles' sines and cosines, and the Euler triple read from the angles in
+    closed form (past 90 deg of pitch: pitch pi - gamma, roll and heading turned by pi), so no rotation object is
+    built and no angle is recovered from a matrix (which loses digits near 90 deg of pitch)."""
+    sp, cp, sr, cr = np.sin(pitch), np.cos(pitch), np.sin(roll), np.cos(roll)
+    sh, ch = np.sin(heading), np.cos(heading)
+    c = ((ch * cr + sh * sp * sr, sh * cp, ch * sr - sh * sp * cr),          # rows of C_b^n
+         (ch * sp * sr - sh * cr, ch * cp, -sh * sr - ch * sp * cr),
+         (-cp * sr, sp, cp * cr))
+
+    def to_body(v):  # C_n^b v = (C_b^n)^T v
+        return np.stack([c[0][j] * v[:, 0] + c[1][j] * v[:, 1] + c[2][j] * v[:, 2] for j in range(3)], axis=-1)
+
+    quat = frames.quat_from_euler(pitch, roll, heading)
+    quat /= np.sqrt(np.einsum("ij,ij->i", quat, quat))[:, None]
+    s = np.where(cp < 0.0, -1.0, 1.0)
+    euler = np.stack([np.arctan2(sp, np.abs(cp)), np.arctan2(s * sr, s * cr),
+                      frames.wrap_2pi(np.arctan2(s * sh, s * ch))], axis=-1)
+    return quat, euler, w_nb_b + to_body(w_in_n), to_body(f_n)
