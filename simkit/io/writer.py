@@ -56,7 +56,9 @@ class _Series:
     def __init__(self, ds: h5py.Dataset):
         self.ds = ds
         self.rows = ds.chunks[0]
-        self.pending: list[np.ndarray] = []
+        self.tail, self.dtype = ds.shape[1:], ds.dtype  # kept here: h5py's ds.shape asks HDF5 each time
+        self.capacity = 0                              # rows of the dataset's extent, whole chunks while growing
+        self.pending: list[np.ndarray] = []            # the writer's own copies
         self.n_pending = 0
         self.n_total = 0
         self.n_chunks = 0
@@ -118,6 +120,9 @@ class Writer:
         try:
             if exc_type is None:
                 for series in self._series.values():
+                    # the exact extent before the padded last chunk is written: shrinking past a written chunk
+                    # would make HDF5 rewrite it through its filters
+                    series.ds.resize(series.n_total, axis=0)
                     self._flush(series, final=True)
                 self._drain(0)
             self._pool.shutdown(wait=True, cancel_futures=True)
@@ -146,45 +151,60 @@ class Writer:
             self._describe(ds, spec, attrs)
             self._series[name] = _Series(ds)
         series = self._series[name]
-        if block.shape[1:] != series.ds.shape[1:] or block.dtype != series.ds.dtype:
+        if block.shape[1:] != series.tail or block.dtype != series.dtype:
             raise ValueError(f"{name}: block of shape {block.shape} {block.dtype} does not extend "
-                             f"{series.ds.shape} {series.ds.dtype}")
-        series.pending.append(block.copy())
-        series.n_pending += len(block)
+                             f"{(series.n_total,) + series.tail} {series.dtype}")
         series.n_total += len(block)
+        if series.n_pending + len(block) < series.rows:  # no full chunk yet: keep a copy (the caller owns block)
+            series.pending.append(block.copy())
+            series.n_pending += len(block)
+            return
+        series.pending.append(block)
+        series.n_pending += len(block)
         self._flush(series, final=False)
 
     def _flush(self, series: _Series, final: bool) -> None:
-        """Send every full chunk (and, at the end, the padded last one) to compression."""
+        """Send every full chunk (and, at the end, the padded last one) to compression. The last of
+        ``series.pending`` may be the caller's array: it is read now or copied, never kept."""
         if series.n_pending == 0 or (series.n_pending < series.rows and not final):
             return
-        data = np.concatenate(series.pending) if len(series.pending) > 1 else series.pending[0]
-        series.ds.resize(series.n_total, axis=0)
+        own = len(series.pending) > 1
+        data = np.concatenate(series.pending) if own else series.pending[0]
+        end = (series.n_chunks + (len(data) + series.rows - 1) // series.rows) * series.rows
+        if not final and end > series.capacity:  # grow by whole chunks, 4x at a time (a resize costs ~0.4 ms)
+            series.capacity = max(end, 4 * series.capacity)
+            series.ds.resize(series.capacity, axis=0)
         start = 0
         while len(data) - start >= series.rows or (final and start < len(data)):
             chunk = data[start:start + series.rows]
             if len(chunk) < series.rows:
                 chunk = np.concatenate([chunk, np.zeros((series.rows - len(chunk),) + chunk.shape[1:], chunk.dtype)])
+            elif not own:
+                chunk = np.ascontiguousarray(chunk)
             offset = (series.n_chunks * series.rows,) + (0,) * (chunk.ndim - 1)
-            self._jobs.append((series.ds, offset) + self._encode(series, chunk))
+            self._encode(series, chunk, offset, own or len(chunk) < series.rows)
             series.n_chunks += 1
             start += series.rows
         rest = data[start:]
-        series.pending = [rest] if len(rest) else []
+        series.pending = [rest.copy()] if len(rest) else []
         series.n_pending = len(rest)
         self._drain(2 * (os.cpu_count() or 1))
 
-    def _encode(self, series: _Series, chunk: np.ndarray) -> tuple[Future, int]:
-        """(the chunk's bytes, to come, and its filter mask): deflated in the pool, or raw when the series' first
-        chunk showed that deflating does not pay."""
+    def _encode(self, series: _Series, chunk: np.ndarray, offset: tuple, own: bool) -> None:
+        """Write the chunk raw now when the series' first chunk showed that deflating does not pay, else queue it
+        for compression in the pool (``own``: ``chunk`` is the writer's; otherwise the pool gets a copy)."""
         if series.raw is None:
             packed = _shuffle_deflate(chunk)
             series.raw = len(packed) > COMPRESS_MAX_RATIO * chunk.nbytes
             if not series.raw:
-                return _Inline.submit(bytes, packed), 0
-        if series.raw:
-            return _Inline.submit(np.ascontiguousarray(chunk).tobytes), SKIP_FILTERS
-        return self._pool.submit(_shuffle_deflate, chunk), 0
+                self._jobs.append((series.ds, offset, _Inline.submit(bytes, packed), 0))
+                return
+        if series.raw:  # written at once from the array itself, ahead of chunks still compressing (any order)
+            series.ds.id.write_direct_chunk(offset, chunk, filter_mask=SKIP_FILTERS)
+            return
+        if not (own or isinstance(self._pool, _Inline)):
+            chunk = chunk.copy()
+        self._jobs.append((series.ds, offset, self._pool.submit(_shuffle_deflate, chunk), 0))
 
     def _drain(self, keep: int) -> None:
         """Write finished chunks in order, keeping at most ``keep`` in flight (bounds memory)."""

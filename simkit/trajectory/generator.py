@@ -58,13 +58,19 @@ class Trajectory:
         return int(np.floor(self.duration_s * rate + 1e-9)) + 1
 
     def _commands(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """The channels at the increasing times ``t``: each segment evaluated only over its support (plus one
+        sample either side, against the rounding of start + duration; it is zero outside)."""
         out = {c: np.zeros_like(t) for c in CHANNELS}
+        if t.size == 0:
+            return out
         lo, hi = t[0], t[-1]
         for item in self.cfg.segments:
             if item.end < lo or item.start > hi:
                 continue
-            for name, value in item.commands(t).items():
-                out[name] += value
+            i0 = max(int(np.searchsorted(t, item.start)) - 1, 0)
+            i1 = int(np.searchsorted(t, item.end, side="right")) + 1
+            for name, value in item.commands(t[i0:i1]).items():
+                out[name][i0:i1] += value
         return out
 
     def blocks(self, rate_hz: float | None = None, block_samples: int = 1 << 16) -> Iterator[TrajectoryTruth]:
@@ -78,20 +84,20 @@ class Trajectory:
             return
         c = self.cfg
         state = np.array([c.speed_m_per_s, c.flight_path_rad, c.heading_rad, c.roll_rad, c.lat_rad, c.lon_rad, c.height_m])
-        first = True
+        # every block holds block_samples samples (the writer's chunks: no block straddles two), the first one
+        # from sample 0, each later one integrated from the last sample of the one before
         k0 = 0
-        while k0 < n_total - 1 or first:
-            k1 = min(k0 + block_samples, n_total - 1)
-            nodes_t = np.arange(k0, k1 + 1) * h
-            truth, state = self._integrate(nodes_t, h, state)
-            yield truth if first else truth.take(slice(1, None))
-            first = False
-            k0 = k1
-            if n_total == 1:
-                break
+        k1 = min(block_samples - 1, n_total - 1)
+        truth, state = self._integrate(np.arange(k0, k1 + 1) * h, h, state, skip=0)
+        yield truth
+        while k1 < n_total - 1:
+            k0, k1 = k1, min(k1 + block_samples, n_total - 1)
+            truth, state = self._integrate(np.arange(k0, k1 + 1) * h, h, state, skip=1)
+            yield truth
 
-    def _integrate(self, t, h, state):
-        """Integrate from ``state`` at t[0] over the nodes ``t``; returns the truth and the state at t[-1]."""
+    def _integrate(self, t, h, state, skip: int):
+        """Integrate from ``state`` at t[0] over the nodes ``t``; returns the truth at the nodes from ``skip`` on
+        and the state at t[-1]."""
         v0, g0_, p0, r0, lat0, lon0, h0 = state
         tm = t[:-1] + 0.5 * h
         cn, cm = self._commands(t), self._commands(tm)
@@ -116,7 +122,9 @@ class Trajectory:
         _, rn_m = earth.radii(lat_m)
         lon, _ = _cumulative(lon0, ve / ((rn + hgt) * np.cos(lat)), ve_m / ((rn_m + hgt_m) * np.cos(lat_m)), h)
 
-        truth = self._assemble(t, cn, speed, gamma, psi, rollx, lat, lon, hgt)
+        k = slice(skip, None)  # views: the truth is formed sample by sample
+        truth = self._assemble(t[k], {name: v[k] for name, v in cn.items()}, speed[k], gamma[k], psi[k], rollx[k],
+                               lat[k], lon[k], hgt[k])
         end = np.array([speed[-1], gamma[-1], psi[-1], rollx[-1], lat[-1], lon[-1], hgt[-1]])
         return truth, end
 
