@@ -22,7 +22,7 @@ import numpy as np
 from .. import earth, frames
 from ..earth import G0
 from .config import TrajectoryConfig
-from .truth import TrajectoryTruth, body_rate_nb, body_truth
+from .truth import TrajectoryTruth, Trig, body_truth, trig
 
 CHANNELS = ("accel", "pitch_rate", "turn_rate", "turn_accel", "roll_rate")
 
@@ -106,32 +106,33 @@ class Trajectory:
         psi, psi_m = _cumulative(p0, cn["turn_rate"], cm["turn_rate"], h)
         rollx, _ = _cumulative(r0, cn["roll_rate"], cm["roll_rate"], h)
 
-        def vel(v, g, p):
-            cg = np.cos(g)
-            return v * cg * np.sin(p), v * cg * np.cos(p), v * np.sin(g)
-
-        ve, vn, vu = vel(speed, gamma, psi)
-        ve_m, vn_m, vu_m = vel(speed_m, gamma_m, psi_m)
+        g_t, p_t = trig(gamma), trig(psi)            # at the nodes: shared with the attitude (half angles)
+        ve, vn, vu = speed * g_t.cos * p_t.sin, speed * g_t.cos * p_t.cos, speed * g_t.sin
+        cg_m = np.cos(gamma_m)
+        ve_m, vn_m, vu_m = speed_m * cg_m * np.sin(psi_m), speed_m * cg_m * np.cos(psi_m), speed_m * np.sin(gamma_m)
         hgt, hgt_m = _cumulative(h0, vu, vu_m, h)
-        lat, lat_m = np.full_like(t, lat0), np.full_like(tm, lat0)
-        for _ in range(3):
+        rm, _ = earth.radii(lat0)    # the first pass from lat0 everywhere: one radius
+        lat, lat_m = _cumulative(lat0, vn / (rm + hgt), vn_m / (rm + hgt_m), h)
+        for _ in range(2):
             rm, _ = earth.radii(lat)
             rm_m, _ = earth.radii(lat_m)
             lat, lat_m = _cumulative(lat0, vn / (rm + hgt), vn_m / (rm_m + hgt_m), h)
-        _, rn = earth.radii(lat)
-        _, rn_m = earth.radii(lat_m)
-        lon, _ = _cumulative(lon0, ve / ((rn + hgt) * np.cos(lat)), ve_m / ((rn_m + hgt_m) * np.cos(lat_m)), h)
+        sl, sl_m, cl = np.sin(lat), np.sin(lat_m), np.cos(lat)
+        _, rn = earth.radii(lat, sl)
+        _, rn_m = earth.radii(lat_m, sl_m)
+        lon, _ = _cumulative(lon0, ve / ((rn + hgt) * cl), ve_m / ((rn_m + hgt_m) * np.cos(lat_m)), h)
 
         k = slice(skip, None)  # views: the truth is formed sample by sample
-        truth = self._assemble(t[k], {name: v[k] for name, v in cn.items()}, speed[k], gamma[k], psi[k], rollx[k],
-                               lat[k], lon[k], hgt[k])
+        truth = self._assemble(t[k], {name: v[k] for name, v in cn.items()}, speed[k],
+                               Trig(*(x[k] for x in g_t)), Trig(*(x[k] for x in p_t)), rollx[k],
+                               np.stack([ve, vn, vu], axis=-1)[k], lat[k], sl[k], cl[k], rn[k], lon[k], hgt[k])
         end = np.array([speed[-1], gamma[-1], psi[-1], rollx[-1], lat[-1], lon[-1], hgt[-1]])
         return truth, end
 
-    def _assemble(self, t, cmd, speed, gamma, psi, rollx, lat, lon, hgt) -> TrajectoryTruth:
+    def _assemble(self, t, cmd, speed, gamma: Trig, psi: Trig, rollx, vel_enu, lat, sin_lat, cos_lat, rn, lon,
+                  hgt) -> TrajectoryTruth:
         gamma_dot, psi_dot = cmd["pitch_rate"], cmd["turn_rate"]
-        cg, sg = np.cos(gamma), np.sin(gamma)
-        cp, sp = np.cos(psi), np.sin(psi)
+        cg, sg, cp, sp = gamma.cos, gamma.sin, psi.cos, psi.sin
         if self.cfg.coordinated_turns:
             num = speed * psi_dot * cg
             num_dot = (cmd["accel"] * psi_dot * cg + speed * cmd["turn_accel"] * cg - speed * psi_dot * sg * gamma_dot)
@@ -142,17 +143,18 @@ class Trajectory:
         roll = bank + rollx
         roll_dot = bank_dot + cmd["roll_rate"]
 
-        vel_enu = np.stack([speed * cg * sp, speed * cg * cp, speed * sg], axis=-1)
         acc_enu = (cmd["accel"][:, None] * np.stack([cg * sp, cg * cp, sg], -1)
                    + (speed * gamma_dot)[:, None] * np.stack([-sg * sp, -sg * cp, cg], -1)
                    + (speed * psi_dot)[:, None] * np.stack([cg * cp, -cg * sp, np.zeros_like(t)], -1))
 
-        w_nb = body_rate_nb(gamma, roll, gamma_dot, roll_dot, psi_dot)
-        w_ie = earth.earth_rate_enu(lat)
-        w_en = earth.transport_rate_enu(lat, hgt, vel_enu)
-        f_n = acc_enu + np.cross(2.0 * w_ie + w_en, vel_enu) - earth.gravity_enu(lat, hgt)
-        quat_nb, euler, omega_ib_b, f_ib_b = body_truth(gamma, roll, psi, w_nb, w_ie + w_en, f_n)
+        w_ie = earth.earth_rate_enu(lat, sin_lat, cos_lat)
+        w_en = earth.transport_rate_enu(lat, hgt, vel_enu, sin_lat)
+        f_n = acc_enu + np.cross(2.0 * w_ie + w_en, vel_enu) - earth.gravity_enu(lat, hgt, sin_lat)
+        quat_nb, euler, omega_ib_b, f_ib_b = body_truth(gamma, trig(roll), psi, (gamma_dot, roll_dot, psi_dot),
+                                                        w_ie + w_en, f_n)
 
         pos_lla = np.stack([lat, lon, hgt], axis=-1)
-        return TrajectoryTruth(t=t, pos_ecef=frames.lla_to_ecef(lat, lon, hgt), pos_lla=pos_lla, vel_enu=vel_enu,
+        r_cos = (rn + hgt) * cos_lat  # geodetic -> ECEF with the prime-vertical radius rn at hand
+        pos_ecef = np.stack([r_cos * np.cos(lon), r_cos * np.sin(lon), (rn * (1.0 - earth.E2) + hgt) * sin_lat], -1)
+        return TrajectoryTruth(t=t, pos_ecef=pos_ecef, pos_lla=pos_lla, vel_enu=vel_enu,
                                quat_nb=quat_nb, euler=euler, omega_ib_b=omega_ib_b, f_ib_b=f_ib_b)

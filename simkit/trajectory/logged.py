@@ -27,7 +27,7 @@ import numpy as np
 from .. import earth, frames
 from ..earth import G0
 from ..errors import DataFileError
-from .truth import TrajectoryTruth, body_rate_nb, body_truth
+from .truth import TrajectoryTruth, body_truth, trig
 
 ATTITUDE_RULES = ("log", "ground", "coordinated")
 MIN_POINTS = 4
@@ -315,7 +315,7 @@ class LoggedPath:
                 roll = roll_dot = np.zeros_like(t)
         w_ie = earth.earth_rate_enu(lat)
         f_n = a_n + np.cross(2.0 * w_ie + w_en, v_n) - earth.gravity_enu(lat, hgt)
-        quat, euler, omega, f_b = body_truth(gamma, roll, psi, body_rate_nb(gamma, roll, gamma_dot, roll_dot, psi_dot),
+        quat, euler, omega, f_b = body_truth(trig(gamma), trig(roll), trig(psi), (gamma_dot, roll_dot, psi_dot),
                                              w_ie + w_en, f_n)
         return TrajectoryTruth(t=t, pos_ecef=r_e, pos_lla=lla, vel_enu=v_n, quat_nb=quat, euler=euler,
                                omega_ib_b=omega, f_ib_b=f_b)
