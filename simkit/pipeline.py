@@ -243,7 +243,7 @@ def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress
             if stages.imu is not None:
                 rows.update(_imu_rows(truth.t, stages.imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)))
             for path, data in rows.items():
-                w.append(path, data)
+                w.append(path, data, handed_over=True)  # fresh arrays of this block, never written to again
             if stages.gnss is not None:
                 _write_gnss(w, stages.gnss, truth, np.nonzero((np.arange(k, k + len(truth.t)) % stride) == 0)[0])
             k += len(truth.t)

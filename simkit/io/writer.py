@@ -50,6 +50,13 @@ def _shuffle_deflate(chunk: np.ndarray) -> bytes:
     return deflate.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
 
 
+def _first_chunk(chunk: np.ndarray) -> tuple[bytes | np.ndarray, int]:
+    """(what to store, filter mask) of a series' first chunk: deflated, or raw when deflating it does not pay
+    (COMPRESS_MAX_RATIO); the series follows this choice."""
+    packed = _shuffle_deflate(chunk)
+    return (chunk, SKIP_FILTERS) if len(packed) > COMPRESS_MAX_RATIO * chunk.nbytes else (packed, 0)
+
+
 class _Series:
     """A growing dataset: rows waiting for a full chunk, and chunks being compressed."""
 
@@ -63,6 +70,7 @@ class _Series:
         self.n_total = 0
         self.n_chunks = 0
         self.raw: bool | None = None  # decided on the first chunk (COMPRESS_MAX_RATIO)
+        self.probe: Future | None = None  # the first chunk's job, until that decision is read from it
 
 
 THREADS_ENV = "SIMKIT_NUM_THREADS"
@@ -102,6 +110,7 @@ class Writer:
         self.file: h5py.File | None = None
         self._series: dict[str, _Series] = {}
         self._jobs: list = []
+        self._in_flight = 2 * (os.cpu_count() or 1)  # chunks being compressed at most (bounds memory)
         threads = compression_threads() if threads is None else threads
         self._pool = _Inline() if threads == 1 else ThreadPoolExecutor(max_workers=threads)
 
@@ -139,9 +148,10 @@ class Writer:
         return dict(chunks=_chunks(shape, np.dtype(dtype).itemsize), compression="gzip", compression_opts=1,
                     shuffle=True)
 
-    def append(self, name: str, block: np.ndarray, attrs: dict | None = None) -> None:
+    def append(self, name: str, block: np.ndarray, attrs: dict | None = None, handed_over: bool = False) -> None:
         """Append ``block`` along axis 0 of dataset ``name`` (declared in :mod:`.schema`; created on first use,
-        resizable)."""
+        resizable). ``handed_over``: the caller never modifies ``block`` afterwards, so the writer may compress
+        it in place of a copy."""
         block = np.asarray(block)
         if name not in self._series:
             spec = schema.check(name, block.dtype, block.shape)
@@ -161,14 +171,14 @@ class Writer:
             return
         series.pending.append(block)
         series.n_pending += len(block)
-        self._flush(series, final=False)
+        self._flush(series, final=False, handed_over=handed_over)
 
-    def _flush(self, series: _Series, final: bool) -> None:
+    def _flush(self, series: _Series, final: bool, handed_over: bool = False) -> None:
         """Send every full chunk (and, at the end, the padded last one) to compression. The last of
-        ``series.pending`` may be the caller's array: it is read now or copied, never kept."""
+        ``series.pending`` may be the caller's array: it is read now or copied, never kept (unless handed over)."""
         if series.n_pending == 0 or (series.n_pending < series.rows and not final):
             return
-        own = len(series.pending) > 1
+        own = len(series.pending) > 1 or handed_over
         data = np.concatenate(series.pending) if own else series.pending[0]
         end = (series.n_chunks + (len(data) + series.rows - 1) // series.rows) * series.rows
         if not final and end > series.capacity:  # grow by whole chunks, 4x at a time (a resize costs ~0.4 ms)
@@ -188,29 +198,32 @@ class Writer:
         rest = data[start:]
         series.pending = [rest.copy()] if len(rest) else []
         series.n_pending = len(rest)
-        self._drain(2 * (os.cpu_count() or 1))
+        self._drain(self._in_flight)
 
     def _encode(self, series: _Series, chunk: np.ndarray, offset: tuple, own: bool) -> None:
         """Write the chunk raw now when the series' first chunk showed that deflating does not pay, else queue it
-        for compression in the pool (``own``: ``chunk`` is the writer's; otherwise the pool gets a copy)."""
-        if series.raw is None:
-            packed = _shuffle_deflate(chunk)
-            series.raw = len(packed) > COMPRESS_MAX_RATIO * chunk.nbytes
-            if not series.raw:
-                self._jobs.append((series.ds, offset, _Inline.submit(bytes, packed), 0))
-                return
+        for compression in the pool (``own``: ``chunk`` is the writer's; otherwise the pool gets a copy). The
+        first chunk is tried in the pool too; the series waits for that answer only at its second chunk."""
+        if series.raw is None and series.probe is not None:
+            series.raw = series.probe.result()[1] == SKIP_FILTERS
+            series.probe = None
         if series.raw:  # written at once from the array itself, ahead of chunks still compressing (any order)
             series.ds.id.write_direct_chunk(offset, chunk, filter_mask=SKIP_FILTERS)
             return
         if not (own or isinstance(self._pool, _Inline)):
             chunk = chunk.copy()
+        if series.raw is None:
+            series.probe = self._pool.submit(_first_chunk, chunk)
+            self._jobs.append((series.ds, offset, series.probe, None))
+            return
         self._jobs.append((series.ds, offset, self._pool.submit(_shuffle_deflate, chunk), 0))
 
     def _drain(self, keep: int) -> None:
         """Write finished chunks in order, keeping at most ``keep`` in flight (bounds memory)."""
         while len(self._jobs) > keep or (self._jobs and self._jobs[0][2].done()):
             ds, offset, job, mask = self._jobs.pop(0)
-            ds.id.write_direct_chunk(offset, job.result(), filter_mask=mask)
+            data, mask = job.result() if mask is None else (job.result(), mask)  # None: a first chunk's job
+            ds.id.write_direct_chunk(offset, data, filter_mask=mask)
 
     def write(self, name: str, data, attrs: dict | None = None) -> None:
         """Write a whole (small, time-independent) dataset declared in :mod:`.schema`."""
