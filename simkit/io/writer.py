@@ -47,7 +47,7 @@ def _chunks(shape, itemsize):
 def _shuffle_deflate(chunk: np.ndarray) -> bytes:
     """The bytes HDF5's shuffle + deflate(level 1) filters make of one full chunk."""
     raw = np.ascontiguousarray(chunk).view(np.uint8).reshape(-1, chunk.dtype.itemsize)
-    return deflate.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
+    return deflate.compress(np.ascontiguousarray(raw.T), 1)  # a buffer: no bytes copy (it faults fresh pages)
 
 
 def _first_chunk(chunk: np.ndarray) -> tuple[bytes | np.ndarray, int]:
