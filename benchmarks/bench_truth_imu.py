@@ -148,7 +148,10 @@ def measure(seconds: float = 600.0, rate: float = 1000.0, peer: str | None = Non
     load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="bench_truth_imu_") as tmp:
         tmp = Path(tmp)
-        child([sys.executable, "-m", "simkit", "run", "--help"], cwd=ROOT)      # warm the page cache, not numba
+        # byte-compiled as pip installs it (PYTHONDONTWRITEBYTECODE would otherwise compile every module in every
+        # run: ~0.05 s), then the page cache warmed (not numba: a truth + IMU run does not import it)
+        child([sys.executable, "-m", "compileall", "-q", str(ROOT / "simkit")], cwd=ROOT)
+        child([sys.executable, "-m", "simkit", "run", "--help"], cwd=ROOT)
         wall, cpu, size = ours(tmp, seconds, rate)
         result = {"samples": n, "seconds": seconds, "rate_hz": rate, "load_before": load,
                   "ours": {"wall_s": wall, "cpu_s": cpu, "bytes": size},
