@@ -178,8 +178,8 @@ class Writer:
         ``series.pending`` may be the caller's array: it is read now or copied, never kept (unless handed over)."""
         if series.n_pending == 0 or (series.n_pending < series.rows and not final):
             return
+        data = np.concatenate(series.pending) if len(series.pending) > 1 else series.pending[0]
         own = len(series.pending) > 1 or handed_over
-        data = np.concatenate(series.pending) if own else series.pending[0]
         end = (series.n_chunks + (len(data) + series.rows - 1) // series.rows) * series.rows
         if not final and end > series.capacity:  # grow by whole chunks, 4x at a time (a resize costs ~0.4 ms)
             series.capacity = max(end, 4 * series.capacity)
@@ -189,8 +189,8 @@ class Writer:
             chunk = data[start:start + series.rows]
             if len(chunk) < series.rows:
                 chunk = np.concatenate([chunk, np.zeros((series.rows - len(chunk),) + chunk.shape[1:], chunk.dtype)])
-            elif not own:
-                chunk = np.ascontiguousarray(chunk)
+            else:
+                chunk = np.ascontiguousarray(chunk)  # a view of a C-ordered block already is (no copy)
             offset = (series.n_chunks * series.rows,) + (0,) * (chunk.ndim - 1)
             self._encode(series, chunk, offset, own or len(chunk) < series.rows)
             series.n_chunks += 1
