@@ -27,5 +27,6 @@ def test_freed_blocks_are_reused_without_page_faults():
 
     default, kept = faults("0"), faults("1")
     assert kept[0] == "True"
-    assert default[1] > 20 * 10 * 256          # glibc's defaults: most of the 2 MB arrays fault in again
+    assert default[1] > 20 * 512               # glibc's defaults: at least a 2 MB array per round faults in again
+    #                                            (35,000-100,000 of the 102,400 pages measured: its thresholds adapt)
     assert kept[1] < 1000                      # kept: the heap serves them from pages already mapped
