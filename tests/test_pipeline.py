@@ -1,7 +1,6 @@
 """End to end: scenario -> HDF5 file; determinism, atomic writes, clear errors with exit code 2."""
 import subprocess
 import sys
-from pathlib import Path
 
 import h5py
 import numpy as np
@@ -32,16 +31,9 @@ def test_same_scenario_and_seed_give_identical_arrays(tmp_path):
 def test_truth_and_imu_run_imports_no_scipy_spatial_numba_or_skyfield(tmp_path):
     """The start-up of a truth + IMU run (the CLI parser of every verb included) stays light: none of those
     modules (about 0.3 s of CPU together) is needed without [gnss]."""
-    import tomllib
+    from truth_imu_scenario import truth_imu_toml
 
-    import tomli_w
-
-    data = tomllib.loads((Path(simkit.__file__).parent / "scenarios" / "high_dynamic.toml").read_text())
-    data.pop("gnss")
-    data["scenario"]["duration_s"] = 2.0
-    data["imu"] = {"preset": "stim300"}
-    path = tmp_path / "truth_imu.toml"
-    path.write_text(tomli_w.dumps(data))
+    path = truth_imu_toml(tmp_path, 2.0)
     code = ("import sys\nfrom simkit.cli import main\n"
             f"assert main(['run', {str(path)!r}, '-o', {str(tmp_path / 'out.h5')!r}, '-q']) == 0\n"
             "print(sorted({m.split('.')[0] + ('.spatial' if m.startswith('scipy.spatial') else '') for m in sys.modules"

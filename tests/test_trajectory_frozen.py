@@ -3,12 +3,11 @@ attitude truth, the shared sines and cosines and the chunk-aligned blocks of iss
 they agree with the old numbers to roundoff, not bit for bit. The bound agreed: 1e-12 relative to each dataset's
 largest value (found: 1e-15; 2e-15 over the 600 s benchmark run); the Euler triple within 1e-12 rad away from 90 deg of pitch, where the old
 conversion from a rotation lost digits (3.6e-12 rad at 0.0006 deg from it) and the new one reads the angles."""
-import tomllib
 from pathlib import Path
 
 import h5py
 import numpy as np
-import tomli_w
+from truth_imu_scenario import truth_imu_toml
 
 import simkit
 
@@ -16,13 +15,7 @@ FROZEN = Path(__file__).parent / "data" / "frozen" / "truth_imu_9857d6a.npz"
 
 
 def test_truth_and_imu_agree_with_the_arrays_before_the_reformulation(tmp_path):
-    data = tomllib.loads((Path(simkit.__file__).parent / "scenarios" / "high_dynamic.toml").read_text())
-    data.pop("gnss")
-    data["scenario"]["duration_s"] = 20.0
-    data["imu"] = {"preset": "stim300"}
-    path = tmp_path / "s.toml"
-    path.write_text(tomli_w.dumps(data))
-    out = simkit.run(str(path), out=tmp_path / "s.h5")
+    out = simkit.run(str(truth_imu_toml(tmp_path, 20.0)), out=tmp_path / "s.h5")
     old = np.load(FROZEN)
     with h5py.File(out, "r") as f:
         assert len(old.files) == 11
