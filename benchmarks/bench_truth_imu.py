@@ -9,7 +9,8 @@ interpreter: ``ins_sim.Sim`` on a motion profile of turns, 200 deg/s rolls and a
 rate, with the STIM300's bias, ARW/VRW and bias instability (first-order Gauss-Markov, its model), ``run()`` and
 ``results(dir)``, its own output (CSV files). Both are timed as child processes: wall time and CPU time
 (user + system of the child, so threads count). Also printed: the peer's generation alone in memory (``path_gen``
-+ ``gyro_gen`` + ``acc_gen``, no start-up, no file), the strictest comparison.
++ ``gyro_gen`` + ``acc_gen``, no start-up, no file), the strictest comparison, and where simkit's CPU goes (one
+more run, instrumented: start-up, imports, truth, IMU, writes, compression).
 
     python benchmarks/bench_truth_imu.py [--seconds 600] [--rate 1000] [--peer DIR] [--json OUT]
     python benchmarks/bench_truth_imu.py --ab OLD_TREE NEW_TREE [--rounds 3]     (before / after, no peer)
@@ -124,6 +125,51 @@ def theirs_in_memory(pathgen, seconds: float, rate: float) -> float:
     return res["nav"].shape[0] / (time.process_time() - c0)
 
 
+BREAKDOWN = r"""
+import json, resource, sys, time
+t_python = time.process_time()                      # the interpreter's own start-up (site, encodings)
+from simkit.heap import keep_freed_memory
+from simkit import pipeline
+from simkit.imu import simulator
+from simkit.trajectory import generator
+t_imports = time.process_time() - t_python
+keep_freed_memory()                                 # as `simkit run` does
+lanes = {"truth": 0.0, "imu": 0.0}
+
+
+def timed(name, fn):
+    def run(*args, **kwargs):
+        c = time.thread_time()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            lanes[name] += time.thread_time() - c
+    return run
+
+
+generator.Trajectory._integrate = timed("truth", generator.Trajectory._integrate)
+simulator.ImuSimulator.process = timed("imu", simulator.ImuSimulator.process)
+w0, m0, p0 = time.perf_counter(), time.thread_time(), time.process_time()
+pipeline.run(sys.argv[1], sys.argv[2])
+main, process = time.thread_time() - m0, time.process_time() - p0
+ru = resource.getrusage(resource.RUSAGE_SELF)
+print(json.dumps({"python": t_python, "imports": t_imports, "run_wall": time.perf_counter() - w0, "run_cpu": process,
+                  "truth_thread": lanes["truth"], "imu": lanes["imu"], "write_main": main - lanes["imu"],
+                  "compression_pool": process - main - lanes["truth"], "user": ru.ru_utime, "system": ru.ru_stime,
+                  "minor_faults": ru.ru_minflt}))
+"""
+
+
+def breakdown(tmp: Path, seconds: float, rate: float) -> dict:
+    """Where one run's CPU goes, in a fresh interpreter (this checkout): the interpreter's start-up, the imports,
+    the truth (its worker thread), the IMU and the rest of the main thread (the HDF5 writes), the compression
+    pool; thread CPU times, user and system time, page faults."""
+    path = tmp / "breakdown.toml"
+    path.write_text(scenario(seconds, rate))
+    _, _, stdout = child([sys.executable, "-c", BREAKDOWN, str(path), str(tmp / "breakdown.h5")], cwd=ROOT)
+    return json.loads(stdout.splitlines()[-1])
+
+
 AB_PROBE = r"""
 import resource, subprocess, sys, time
 tree, scenario = sys.argv[1], sys.argv[2]
@@ -148,11 +194,15 @@ def measure(seconds: float = 600.0, rate: float = 1000.0, peer: str | None = Non
     load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="bench_truth_imu_") as tmp:
         tmp = Path(tmp)
-        child([sys.executable, "-m", "simkit", "run", "--help"], cwd=ROOT)      # warm the page cache, not numba
+        # byte-compiled as pip installs it (PYTHONDONTWRITEBYTECODE would otherwise compile every module in every
+        # run: ~0.05 s), then the page cache warmed (not numba: a truth + IMU run does not import it)
+        child([sys.executable, "-m", "compileall", "-q", str(ROOT / "simkit")], cwd=ROOT)
+        child([sys.executable, "-m", "simkit", "run", "--help"], cwd=ROOT)
         wall, cpu, size = ours(tmp, seconds, rate)
         result = {"samples": n, "seconds": seconds, "rate_hz": rate, "load_before": load,
                   "ours": {"wall_s": wall, "cpu_s": cpu, "bytes": size},
                   "peer": None, "peer_in_memory_samples_per_s": None}
+        result["breakdown"] = breakdown(tmp, seconds, rate)
         pathgen = peers.gnss_ins_sim(peer)
         if pathgen is not None:
             checkout = Path(pathgen.__file__).resolve().parents[2]
@@ -204,6 +254,11 @@ def main(argv=None) -> int:
           + (f", gnss-ins-sim CSV {r['peer']['bytes'] / 1e6:.0f} MB" if r["peer"] else
              "; gnss-ins-sim not found (--peer DIR or GNSS_INS_SIM=DIR): no peer figure"))
     timing.print_table(["figure", "simkit", "gnss-ins-sim", "ratio"], report(r))
+    b = r["breakdown"]
+    print(f"simkit's CPU, one more run in the same session (thread CPU s): interpreter {b['python']:.2f}, imports "
+          f"{b['imports']:.2f}, truth (worker thread) {b['truth_thread']:.2f}, IMU {b['imu']:.2f}, writes (main "
+          f"thread) {b['write_main']:.2f}, compression pool {b['compression_pool']:.2f}; run wall {b['run_wall']:.2f} s; "
+          f"process user {b['user']:.2f} + system {b['system']:.2f} s, {b['minor_faults']:,} page faults")
     if args.json:
         Path(args.json).write_text(json.dumps(r, indent=1))
     return 0

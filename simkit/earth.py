@@ -27,42 +27,43 @@ G0 = 9.80665                       # standard gravity, m/s^2: the unit behind "g
 ELLIPSOID = pymap3d.Ellipsoid(A, B, name="WGS-84", model="wgs84")  # the same a and b, for pymap3d's geodesy
 
 
-def radii(lat):
-    """Meridian (R_M) and prime-vertical (R_N) radii of curvature at geodetic latitude ``lat`` (rad), m."""
-    s2 = np.sin(lat) ** 2
+def radii(lat, sin_lat=None):
+    """Meridian (R_M) and prime-vertical (R_N) radii of curvature at geodetic latitude ``lat`` (rad), m.
+    ``sin_lat``: sin(lat) when the caller has it (here and below: the same numbers, one sine fewer)."""
+    s2 = (np.sin(lat) if sin_lat is None else sin_lat) ** 2
     w = np.sqrt(1.0 - E2 * s2)
     rn = A / w
     rm = A * (1.0 - E2) / w**3
     return rm, rn
 
 
-def normal_gravity(lat, h):
+def normal_gravity(lat, h, sin_lat=None):
     """Magnitude of WGS-84 normal gravity (m/s^2) at geodetic latitude ``lat`` (rad) and height ``h`` (m)."""
-    s2 = np.sin(lat) ** 2
+    s2 = (np.sin(lat) if sin_lat is None else sin_lat) ** 2
     g0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / np.sqrt(1.0 - E2 * s2)
     return g0 * (1.0 - 2.0 / A * (1.0 + F + M_RATIO - 2.0 * F * s2) * h + 3.0 * h**2 / A**2)
 
 
-def gravity_enu(lat, h):
+def gravity_enu(lat, h, sin_lat=None):
     """Normal gravity vector in ENU, (..., 3) m/s^2: [0, 0, -gamma(lat, h)]."""
-    g = np.asarray(normal_gravity(lat, h), dtype=float)
+    g = np.asarray(normal_gravity(lat, h, sin_lat), dtype=float)
     out = np.zeros(g.shape + (3,))
     out[..., 2] = -g
     return out
 
 
-def earth_rate_enu(lat):
+def earth_rate_enu(lat, sin_lat=None, cos_lat=None):
     """Earth rotation rate w_ie^n in ENU, (..., 3) rad/s."""
     lat = np.asarray(lat, dtype=float)
     out = np.zeros(lat.shape + (3,))
-    out[..., 1] = OMEGA_E * np.cos(lat)
-    out[..., 2] = OMEGA_E * np.sin(lat)
+    out[..., 1] = OMEGA_E * (np.cos(lat) if cos_lat is None else cos_lat)
+    out[..., 2] = OMEGA_E * (np.sin(lat) if sin_lat is None else sin_lat)
     return out
 
 
-def transport_rate_enu(lat, h, vel_enu):
+def transport_rate_enu(lat, h, vel_enu, sin_lat=None):
     """Transport rate w_en^n in ENU, (..., 3) rad/s, for velocity ``vel_enu`` (m/s, relative to Earth)."""
-    rm, rn = radii(lat)
+    rm, rn = radii(lat, sin_lat)
     v = np.asarray(vel_enu, dtype=float)
     out = np.empty(v.shape)
     out[..., 0] = -v[..., 1] / (rm + h)

@@ -7,11 +7,15 @@ ordered [pitch, roll, heading]. Positive pitch is nose up, positive roll is righ
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pymap3d
-from scipy.spatial.transform import Rotation
 
 from . import earth
+
+if TYPE_CHECKING:  # imported where used: scipy.spatial costs a truth + IMU run ~0.25 s of start-up it never needs
+    from scipy.spatial.transform import Rotation
 
 # ENU <-> NED and body right-forward-up <-> forward-right-down: the same proper rotation (it is its own inverse)
 SWAP = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
@@ -91,6 +95,8 @@ def quat_from_euler(pitch, roll, heading) -> np.ndarray:
 
 def attitude_from_euler(pitch, roll, heading) -> Rotation:
     """Body -> ENU rotation(s) from pitch, roll, heading (rad)."""
+    from scipy.spatial.transform import Rotation
+
     return Rotation.from_quat(quat_from_euler(pitch, roll, heading))
 
 
@@ -112,6 +118,8 @@ def lever_arm_ecef(pos, vel, quat_nb, omega_ib_b, lever_b):
     (M, 3, 3)."""
     lla = ecef_to_lla(pos)
     c_en = ecef_to_enu_matrix(lla[:, 0], lla[:, 1])                       # C_e^n (M, 3, 3)
+    from scipy.spatial.transform import Rotation
+
     c_nb = Rotation.from_quat(np.asarray(quat_nb, dtype=float).reshape(-1, 4)).as_matrix()
     c_be = np.einsum("mji,mjk->mik", c_en, c_nb)                          # C_b^e = (C_e^n)^T C_b^n
     w_eb = np.asarray(omega_ib_b, dtype=float).reshape(-1, 3) - np.einsum("mji,j->mi", c_be, earth.EARTH_RATE_ECEF)
@@ -123,6 +131,8 @@ def lever_arm_ecef(pos, vel, quat_nb, omega_ib_b, lever_b):
 def euler_jacobian(rot: Rotation, step: float = 1e-6) -> np.ndarray:
     """(K, 3, 3) derivative of Euler [pitch, roll, heading] (rad) with respect to a small ENU rotation phi (rad),
     C = exp([phi x]) C_b^n, at the K attitudes ``rot`` (body -> ENU), by central differences of ``step`` rad."""
+    from scipy.spatial.transform import Rotation
+
     cols = []
     for axis in np.eye(3):
         d = euler_from_attitude(Rotation.from_rotvec(step * axis) * rot) - euler_from_attitude(
@@ -142,6 +152,8 @@ ned_to_enu = enu_to_ned  # the swap is an involution
 
 def attitude_to_ned_frd(rot: Rotation) -> Rotation:
     """Body(RFU) -> ENU attitude -> body(FRD) -> NED attitude, for users of the aerospace convention."""
+    from scipy.spatial.transform import Rotation
+
     s = Rotation.from_matrix(SWAP)
     return s * rot * s
 

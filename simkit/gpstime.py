@@ -31,13 +31,32 @@ def timescale():
     return load.timescale(builtin=True)
 
 
+@lru_cache(maxsize=1)
+def leap_table() -> tuple[np.ndarray, np.ndarray]:
+    """skyfield's built-in leap-second table: the UTC Julian dates of the steps and TAI - UTC (s) from each on.
+
+    Read from skyfield's bundled data file (the arrays ``timescale(builtin=True)`` is built from) without importing
+    skyfield, whose import costs a truth + IMU run 0.05 s; through skyfield's timescale when the file is not where
+    this skyfield version keeps it."""
+    import importlib.util
+    from pathlib import Path
+
+    try:
+        spec = importlib.util.find_spec("skyfield")
+        with np.load(Path(spec.submodule_search_locations[0]) / "data" / "iers.npz") as arrays:
+            return arrays["leap_dates"], arrays["leap_offsets"]
+    except (AttributeError, TypeError, IndexError, OSError, KeyError, ValueError):
+        ts = timescale()
+        return ts.leap_dates, ts.leap_offsets
+
+
 def leap_seconds(utc: datetime) -> float:
     """TAI - UTC in seconds at a UTC instant (from skyfield's built-in table)."""
-    ts = timescale()
+    dates, offsets = leap_table()
     utc = _aware(utc)
     jd = 2440587.5 + utc.timestamp() / 86400.0
-    i = np.searchsorted(ts.leap_dates, jd, side="right") - 1
-    return float(ts.leap_offsets[i]) if i >= 0 else 10.0
+    i = np.searchsorted(dates, jd, side="right") - 1
+    return float(offsets[i]) if i >= 0 else 10.0
 
 
 def _aware(t: datetime) -> datetime:

@@ -9,7 +9,8 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import TYPE_CHECKING
+from concurrent.futures import ThreadPoolExecutor
+from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
 
@@ -17,7 +18,7 @@ from . import gpstime
 from .errors import DataFileError, OutputError, ScenarioError
 from .imu import ImuSimulator
 from .io.output import check_output
-from .io.writer import Writer
+from .io.writer import Writer, compression_threads
 from .scenario import Scenario, load, resolve
 from .trajectory import Trajectory
 
@@ -63,8 +64,9 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
     source = None if isinstance(scenario, dict) else _scenario_file(scenario)
     check_output(out, inputs=[source], estimated_bytes=size, force=force, simkit_only=True)
     stages = build(sc, sky)
+    threads = compression_threads() if threads is None else threads
     with Writer(out, root_attributes(sc), threads) as w:
-        _write(w, sc, stages, block_samples, progress)
+        _write(w, sc, stages, block_samples, progress, ahead=threads > 1)
     return out
 
 
@@ -228,7 +230,21 @@ def _write_static(w: Writer, sc: Scenario, stages: Stages) -> None:
             w.write(path, data)
 
 
-def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress: bool) -> None:
+def _truth_ahead(blocks: Iterator, ahead: bool) -> Iterator:
+    """The truth blocks, each computed on a worker thread while the caller processes the one before (numpy
+    releases the GIL in its loops, so the truth and the IMU + write share two cores); in order, as computed
+    alone. ``ahead`` False: on the calling thread."""
+    if not ahead:
+        yield from blocks
+        return
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="simkit-truth") as worker:
+        nxt = worker.submit(next, blocks, None)
+        while (block := nxt.result()) is not None:
+            nxt = worker.submit(next, blocks, None)
+            yield block
+
+
+def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress: bool, ahead: bool = False) -> None:
     _write_static(w, sc, stages)
     bar = None
     if progress:
@@ -238,12 +254,12 @@ def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress
     stride = int(round(sc.trajectory.rate_hz / sc.gnss.rate_hz)) if stages.gnss is not None else 0
     k = 0
     try:
-        for truth in stages.trajectory.blocks(block_samples=block_samples):
+        for truth in _truth_ahead(stages.trajectory.blocks(block_samples=block_samples), ahead):
             rows = _rows("truth", truth)
             if stages.imu is not None:
                 rows.update(_imu_rows(truth.t, stages.imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)))
             for path, data in rows.items():
-                w.append(path, data)
+                w.append(path, data, handed_over=True)  # fresh arrays of this block, never written to again
             if stages.gnss is not None:
                 _write_gnss(w, stages.gnss, truth, np.nonzero((np.arange(k, k + len(truth.t)) % stride) == 0)[0])
             k += len(truth.t)

@@ -40,6 +40,17 @@ def test_normal_gravity_matches_tr8350_values():
     assert (earth.normal_gravity(0.8, 100.0) - earth.normal_gravity(0.8, 0.0)) / 100 == pytest.approx(-3.086e-6, rel=0.01)
 
 
+def test_leap_table_is_skyfields_builtin_table():
+    # read from skyfield's data file without importing skyfield: the same arrays as its timescale(builtin=True)
+    from skyfield.api import load
+
+    ts = load.timescale(builtin=True)
+    dates, offsets = gpstime.leap_table()
+    np.testing.assert_array_equal(dates, ts.leap_dates)
+    np.testing.assert_array_equal(offsets, ts.leap_offsets)
+    assert offsets[-1] == 37.0 and dates[-1] == 2457754.5  # TAI - UTC = 37 s from 2017-01-01 (IERS Bulletin C 52)
+
+
 def test_gps_time_leap_seconds_and_bdt():
     assert gpstime.utc_to_gps(datetime(2016, 11, 8, tzinfo=timezone.utc)) == (1922, 172817.0)
     assert gpstime.utc_to_gps(datetime(1980, 1, 6, tzinfo=timezone.utc)) == (0, 0.0)

@@ -28,6 +28,23 @@ def test_same_scenario_and_seed_give_identical_arrays(tmp_path):
         assert np.array_equal(xa[k], xb[k], equal_nan=xa[k].dtype.kind == "f"), k
 
 
+def test_truth_and_imu_run_imports_no_scipy_spatial_numba_or_skyfield(tmp_path):
+    """The start-up of a truth + IMU run (the CLI parser of every verb included) stays light: none of those
+    modules (about 0.3 s of CPU together) is needed without [gnss]."""
+    from truth_imu_scenario import truth_imu_toml
+
+    path = truth_imu_toml(tmp_path, 2.0)
+    code = ("import sys\nfrom simkit.cli import main\n"
+            f"assert main(['run', {str(path)!r}, '-o', {str(tmp_path / 'out.h5')!r}, '-q']) == 0\n"
+            "print(sorted({m.split('.')[0] + ('.spatial' if m.startswith('scipy.spatial') else '') for m in sys.modules"
+            " if m.startswith(('scipy.spatial', 'numba', 'skyfield'))}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"
+    with h5py.File(tmp_path / "out.h5", "r") as f:
+        assert f["imu/gyro"].shape == (201, 3) and "imu/errors/gyro_bias" in f
+
+
 def test_bad_thread_count_in_the_environment_is_one_clean_line(tmp_path):
     env = {**__import__("os").environ, "SIMKIT_NUM_THREADS": "two"}
     out = subprocess.run([sys.executable, "-m", "simkit", "run", "quickstart", "-o", str(tmp_path / "q.h5")],

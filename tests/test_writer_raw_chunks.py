@@ -24,3 +24,31 @@ def test_noise_is_stored_raw_and_smooth_truth_compressed(tmp_path):
         assert {white.id.get_chunk_info(i).filter_mask for i in range(3)} == {SKIP_FILTERS}
         assert {time.id.get_chunk_info(i).filter_mask for i in range(time.id.get_num_chunks())} == {0}
         assert time.id.get_chunk_info(0).size < 0.1 * CHUNK_ROWS * 8
+
+
+def test_chunk_aligned_blocks_handed_over_or_copied_and_reused_buffers(tmp_path):
+    """Blocks of exactly one chunk go to the pool without a copy when handed over; a caller that reuses its buffer
+    (not handed over) still gets what it appended; a series shorter than a chunk (its first chunk is the padded
+    last one) and the single-thread writer give the same arrays."""
+    n = 3 * CHUNK_ROWS + 10
+    rng = np.random.default_rng(1)
+    noise, smooth = rng.standard_normal((n, 3)), np.cumsum(np.full((n, 3), 1e-3), axis=0)
+    for threads in (1, 2):
+        path = tmp_path / f"a{threads}.h5"
+        buffer = np.empty((CHUNK_ROWS, 3))
+        with Writer(path, {}, threads=threads) as w:
+            w.append("truth/t", np.arange(7) * 0.5)
+            for a in range(0, n, CHUNK_ROWS):
+                w.append("imu/errors/gyro_white", noise[a:a + CHUNK_ROWS].copy(), handed_over=True)
+                part = smooth[a:a + CHUNK_ROWS]
+                buffer[:len(part)] = part
+                w.append("truth/f_ib_b", buffer[:len(part)])
+                buffer[:] = -1.0                                # the caller reuses its buffer at once
+        with h5py.File(path, "r") as f:
+            np.testing.assert_array_equal(f["imu/errors/gyro_white"][...], noise)
+            np.testing.assert_array_equal(f["truth/f_ib_b"][...], smooth)
+            np.testing.assert_array_equal(f["truth/t"][...], np.arange(7) * 0.5)
+            white, force = f["imu/errors/gyro_white"].id, f["truth/f_ib_b"].id
+            assert white.get_num_chunks() == force.get_num_chunks() == 4
+            assert {white.get_chunk_info(i).filter_mask for i in range(4)} == {SKIP_FILTERS}
+            assert {force.get_chunk_info(i).filter_mask for i in range(4)} == {0}

@@ -5,9 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import InputError, OutputError
-from .streams import BODY_FRAMES, STAMPS, read_streams
-
-FORMATS = ("rosbag2", "csv", "kml")
+from .choices import BODY_FRAMES, FORMATS, STAMPS
 
 __all__ = ["FORMATS", "BODY_FRAMES", "STAMPS", "export"]
 
@@ -32,6 +30,8 @@ def export(path, fmt: str, out, frame: str = "ned-frd", stamp: str = "unix", fix
         if importlib.util.find_spec("rosbags") is None:
             raise InputError("--format rosbag2", "needs the 'rosbags' package: pip install 'simkit[export]'")
         _replaceable_bag(out)
+    from .streams import read_streams  # here: the parser of `simkit export` imports this package
+
     streams = read_streams(path)
     if fmt == "csv":
         from . import csvout

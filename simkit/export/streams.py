@@ -16,7 +16,6 @@ from .. import frames, gpstime
 from ..earth import EARTH_RATE_ECEF
 from ..errors import DataFileError
 
-BODY_FRAMES = ("ned-frd", "enu-rfu", "enu-flu")
 RFU_TO_FLU = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])   # v_flu = RFU_TO_FLU @ v_rfu
 _FLU_IN_RFU = Rotation.from_matrix(RFU_TO_FLU.T)                              # C_flu^rfu
 
@@ -96,8 +95,6 @@ def omega_eb_b(truth: dict) -> np.ndarray:
     w_ie_n = np.einsum("nij,j->ni", c_en, EARTH_RATE_ECEF)
     return truth["omega_ib_b"] - Rotation.from_quat(truth["quat_nb"]).inv().apply(w_ie_n)
 
-
-STAMPS = ("unix", "gps", "start")
 
 
 def stamps_ns(start: tuple[int, float], t, stamp: str) -> np.ndarray:

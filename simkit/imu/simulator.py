@@ -60,8 +60,12 @@ def truth_increments(x: np.ndarray, prev: np.ndarray | None, dt: float) -> np.nd
 
 
 def _apply(matrix: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """x @ matrix.T elementwise: unlike BLAS, the rounding does not depend on the block length."""
-    return x[:, 0:1] * matrix[:, 0] + x[:, 1:2] * matrix[:, 1] + x[:, 2:3] * matrix[:, 2]
+    """x @ matrix.T elementwise: unlike BLAS, the rounding does not depend on the block length. Column by column
+    (N-long loops: broadcasting (N, 1) against (3,) runs N loops of 3, 3.5x slower; the same sums)."""
+    out = np.empty_like(x)
+    for j in range(3):
+        out[:, j] = x[:, 0] * matrix[j, 0] + x[:, 1] * matrix[j, 1] + x[:, 2] * matrix[j, 2]
+    return out
 
 
 class _Sensor:

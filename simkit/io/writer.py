@@ -47,7 +47,14 @@ def _chunks(shape, itemsize):
 def _shuffle_deflate(chunk: np.ndarray) -> bytes:
     """The bytes HDF5's shuffle + deflate(level 1) filters make of one full chunk."""
     raw = np.ascontiguousarray(chunk).view(np.uint8).reshape(-1, chunk.dtype.itemsize)
-    return deflate.compress(np.ascontiguousarray(raw.T).tobytes(), 1)
+    return deflate.compress(np.ascontiguousarray(raw.T), 1)  # a buffer: no bytes copy (it faults fresh pages)
+
+
+def _first_chunk(chunk: np.ndarray) -> tuple[bytes | np.ndarray, int]:
+    """(what to store, filter mask) of a series' first chunk: deflated, or raw when deflating it does not pay
+    (COMPRESS_MAX_RATIO); the series follows this choice."""
+    packed = _shuffle_deflate(chunk)
+    return (chunk, SKIP_FILTERS) if len(packed) > COMPRESS_MAX_RATIO * chunk.nbytes else (packed, 0)
 
 
 class _Series:
@@ -56,11 +63,14 @@ class _Series:
     def __init__(self, ds: h5py.Dataset):
         self.ds = ds
         self.rows = ds.chunks[0]
-        self.pending: list[np.ndarray] = []
+        self.tail, self.dtype = ds.shape[1:], ds.dtype  # kept here: h5py's ds.shape asks HDF5 each time
+        self.capacity = 0                              # rows of the dataset's extent, whole chunks while growing
+        self.pending: list[np.ndarray] = []            # the writer's own copies
         self.n_pending = 0
         self.n_total = 0
         self.n_chunks = 0
         self.raw: bool | None = None  # decided on the first chunk (COMPRESS_MAX_RATIO)
+        self.probe: Future | None = None  # the first chunk's job, until that decision is read from it
 
 
 THREADS_ENV = "SIMKIT_NUM_THREADS"
@@ -100,6 +110,7 @@ class Writer:
         self.file: h5py.File | None = None
         self._series: dict[str, _Series] = {}
         self._jobs: list = []
+        self._in_flight = 2 * (os.cpu_count() or 1)  # chunks being compressed at most (bounds memory)
         threads = compression_threads() if threads is None else threads
         self._pool = _Inline() if threads == 1 else ThreadPoolExecutor(max_workers=threads)
 
@@ -118,6 +129,9 @@ class Writer:
         try:
             if exc_type is None:
                 for series in self._series.values():
+                    # the exact extent before the padded last chunk is written: shrinking past a written chunk
+                    # would make HDF5 rewrite it through its filters
+                    series.ds.resize(series.n_total, axis=0)
                     self._flush(series, final=True)
                 self._drain(0)
             self._pool.shutdown(wait=True, cancel_futures=True)
@@ -134,9 +148,10 @@ class Writer:
         return dict(chunks=_chunks(shape, np.dtype(dtype).itemsize), compression="gzip", compression_opts=1,
                     shuffle=True)
 
-    def append(self, name: str, block: np.ndarray, attrs: dict | None = None) -> None:
+    def append(self, name: str, block: np.ndarray, attrs: dict | None = None, handed_over: bool = False) -> None:
         """Append ``block`` along axis 0 of dataset ``name`` (declared in :mod:`.schema`; created on first use,
-        resizable)."""
+        resizable). ``handed_over``: the caller never modifies ``block`` afterwards, so the writer may compress
+        it in place of a copy."""
         block = np.asarray(block)
         if name not in self._series:
             spec = schema.check(name, block.dtype, block.shape)
@@ -146,51 +161,69 @@ class Writer:
             self._describe(ds, spec, attrs)
             self._series[name] = _Series(ds)
         series = self._series[name]
-        if block.shape[1:] != series.ds.shape[1:] or block.dtype != series.ds.dtype:
+        if block.shape[1:] != series.tail or block.dtype != series.dtype:
             raise ValueError(f"{name}: block of shape {block.shape} {block.dtype} does not extend "
-                             f"{series.ds.shape} {series.ds.dtype}")
-        series.pending.append(block.copy())
-        series.n_pending += len(block)
+                             f"{(series.n_total,) + series.tail} {series.dtype}")
         series.n_total += len(block)
-        self._flush(series, final=False)
+        if series.n_pending + len(block) < series.rows:  # no full chunk yet: keep a copy (the caller owns block)
+            series.pending.append(block.copy())
+            series.n_pending += len(block)
+            return
+        series.pending.append(block)
+        series.n_pending += len(block)
+        self._flush(series, final=False, handed_over=handed_over)
 
-    def _flush(self, series: _Series, final: bool) -> None:
-        """Send every full chunk (and, at the end, the padded last one) to compression."""
+    def _flush(self, series: _Series, final: bool, handed_over: bool = False) -> None:
+        """Send every full chunk (and, at the end, the padded last one) to compression. The last of
+        ``series.pending`` may be the caller's array: it is read now or copied, never kept (unless handed over)."""
         if series.n_pending == 0 or (series.n_pending < series.rows and not final):
             return
         data = np.concatenate(series.pending) if len(series.pending) > 1 else series.pending[0]
-        series.ds.resize(series.n_total, axis=0)
+        own = len(series.pending) > 1 or handed_over
+        end = (series.n_chunks + (len(data) + series.rows - 1) // series.rows) * series.rows
+        if not final and end > series.capacity:  # grow by whole chunks, 4x at a time (a resize costs ~0.4 ms)
+            series.capacity = max(end, 4 * series.capacity)
+            series.ds.resize(series.capacity, axis=0)
         start = 0
         while len(data) - start >= series.rows or (final and start < len(data)):
             chunk = data[start:start + series.rows]
             if len(chunk) < series.rows:
                 chunk = np.concatenate([chunk, np.zeros((series.rows - len(chunk),) + chunk.shape[1:], chunk.dtype)])
+            else:
+                chunk = np.ascontiguousarray(chunk)  # a view of a C-ordered block already is (no copy)
             offset = (series.n_chunks * series.rows,) + (0,) * (chunk.ndim - 1)
-            self._jobs.append((series.ds, offset) + self._encode(series, chunk))
+            self._encode(series, chunk, offset, own or len(chunk) < series.rows)
             series.n_chunks += 1
             start += series.rows
         rest = data[start:]
-        series.pending = [rest] if len(rest) else []
+        series.pending = [rest.copy()] if len(rest) else []
         series.n_pending = len(rest)
-        self._drain(2 * (os.cpu_count() or 1))
+        self._drain(self._in_flight)
 
-    def _encode(self, series: _Series, chunk: np.ndarray) -> tuple[Future, int]:
-        """(the chunk's bytes, to come, and its filter mask): deflated in the pool, or raw when the series' first
-        chunk showed that deflating does not pay."""
+    def _encode(self, series: _Series, chunk: np.ndarray, offset: tuple, own: bool) -> None:
+        """Write the chunk raw now when the series' first chunk showed that deflating does not pay, else queue it
+        for compression in the pool (``own``: ``chunk`` is the writer's; otherwise the pool gets a copy). The
+        first chunk is tried in the pool too; the series waits for that answer only at its second chunk."""
+        if series.raw is None and series.probe is not None:
+            series.raw = series.probe.result()[1] == SKIP_FILTERS
+            series.probe = None
+        if series.raw:  # written at once from the array itself, ahead of chunks still compressing (any order)
+            series.ds.id.write_direct_chunk(offset, chunk, filter_mask=SKIP_FILTERS)
+            return
+        if not (own or isinstance(self._pool, _Inline)):
+            chunk = chunk.copy()
         if series.raw is None:
-            packed = _shuffle_deflate(chunk)
-            series.raw = len(packed) > COMPRESS_MAX_RATIO * chunk.nbytes
-            if not series.raw:
-                return _Inline.submit(bytes, packed), 0
-        if series.raw:
-            return _Inline.submit(np.ascontiguousarray(chunk).tobytes), SKIP_FILTERS
-        return self._pool.submit(_shuffle_deflate, chunk), 0
+            series.probe = self._pool.submit(_first_chunk, chunk)
+            self._jobs.append((series.ds, offset, series.probe, None))
+            return
+        self._jobs.append((series.ds, offset, self._pool.submit(_shuffle_deflate, chunk), 0))
 
     def _drain(self, keep: int) -> None:
         """Write finished chunks in order, keeping at most ``keep`` in flight (bounds memory)."""
         while len(self._jobs) > keep or (self._jobs and self._jobs[0][2].done()):
             ds, offset, job, mask = self._jobs.pop(0)
-            ds.id.write_direct_chunk(offset, job.result(), filter_mask=mask)
+            data, mask = job.result() if mask is None else (job.result(), mask)  # None: a first chunk's job
+            ds.id.write_direct_chunk(offset, data, filter_mask=mask)
 
     def write(self, name: str, data, attrs: dict | None = None) -> None:
         """Write a whole (small, time-independent) dataset declared in :mod:`.schema`."""

@@ -18,12 +18,11 @@ from __future__ import annotations
 from typing import Iterator
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .. import earth, frames
 from ..earth import G0
 from .config import TrajectoryConfig
-from .truth import TrajectoryTruth, body_rate_nb
+from .truth import TrajectoryTruth, Trig, body_truth, trig
 
 CHANNELS = ("accel", "pitch_rate", "turn_rate", "turn_accel", "roll_rate")
 
@@ -59,13 +58,19 @@ class Trajectory:
         return int(np.floor(self.duration_s * rate + 1e-9)) + 1
 
     def _commands(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """The channels at the increasing times ``t``: each segment evaluated only over its support (plus one
+        sample either side, against the rounding of start + duration; it is zero outside)."""
         out = {c: np.zeros_like(t) for c in CHANNELS}
+        if t.size == 0:
+            return out
         lo, hi = t[0], t[-1]
         for item in self.cfg.segments:
             if item.end < lo or item.start > hi:
                 continue
-            for name, value in item.commands(t).items():
-                out[name] += value
+            i0 = max(int(np.searchsorted(t, item.start)) - 1, 0)
+            i1 = int(np.searchsorted(t, item.end, side="right")) + 1
+            for name, value in item.commands(t[i0:i1]).items():
+                out[name][i0:i1] += value
         return out
 
     def blocks(self, rate_hz: float | None = None, block_samples: int = 1 << 16) -> Iterator[TrajectoryTruth]:
@@ -79,20 +84,20 @@ class Trajectory:
             return
         c = self.cfg
         state = np.array([c.speed_m_per_s, c.flight_path_rad, c.heading_rad, c.roll_rad, c.lat_rad, c.lon_rad, c.height_m])
-        first = True
+        # every block holds block_samples samples (the writer's chunks: no block straddles two), the first one
+        # from sample 0, each later one integrated from the last sample of the one before
         k0 = 0
-        while k0 < n_total - 1 or first:
-            k1 = min(k0 + block_samples, n_total - 1)
-            nodes_t = np.arange(k0, k1 + 1) * h
-            truth, state = self._integrate(nodes_t, h, state)
-            yield truth if first else truth.take(slice(1, None))
-            first = False
-            k0 = k1
-            if n_total == 1:
-                break
+        k1 = min(block_samples - 1, n_total - 1)
+        truth, state = self._integrate(np.arange(k0, k1 + 1) * h, h, state, skip=0)
+        yield truth
+        while k1 < n_total - 1:
+            k0, k1 = k1, min(k1 + block_samples, n_total - 1)
+            truth, state = self._integrate(np.arange(k0, k1 + 1) * h, h, state, skip=1)
+            yield truth
 
-    def _integrate(self, t, h, state):
-        """Integrate from ``state`` at t[0] over the nodes ``t``; returns the truth and the state at t[-1]."""
+    def _integrate(self, t, h, state, skip: int):
+        """Integrate from ``state`` at t[0] over the nodes ``t``; returns the truth at the nodes from ``skip`` on
+        and the state at t[-1]."""
         v0, g0_, p0, r0, lat0, lon0, h0 = state
         tm = t[:-1] + 0.5 * h
         cn, cm = self._commands(t), self._commands(tm)
@@ -101,30 +106,33 @@ class Trajectory:
         psi, psi_m = _cumulative(p0, cn["turn_rate"], cm["turn_rate"], h)
         rollx, _ = _cumulative(r0, cn["roll_rate"], cm["roll_rate"], h)
 
-        def vel(v, g, p):
-            cg = np.cos(g)
-            return v * cg * np.sin(p), v * cg * np.cos(p), v * np.sin(g)
-
-        ve, vn, vu = vel(speed, gamma, psi)
-        ve_m, vn_m, vu_m = vel(speed_m, gamma_m, psi_m)
+        g_t, p_t = trig(gamma), trig(psi)            # at the nodes: shared with the attitude (half angles)
+        ve, vn, vu = speed * g_t.cos * p_t.sin, speed * g_t.cos * p_t.cos, speed * g_t.sin
+        cg_m = np.cos(gamma_m)
+        ve_m, vn_m, vu_m = speed_m * cg_m * np.sin(psi_m), speed_m * cg_m * np.cos(psi_m), speed_m * np.sin(gamma_m)
         hgt, hgt_m = _cumulative(h0, vu, vu_m, h)
-        lat, lat_m = np.full_like(t, lat0), np.full_like(tm, lat0)
-        for _ in range(3):
+        rm, _ = earth.radii(lat0)    # the first pass from lat0 everywhere: one radius
+        lat, lat_m = _cumulative(lat0, vn / (rm + hgt), vn_m / (rm + hgt_m), h)
+        for _ in range(2):
             rm, _ = earth.radii(lat)
             rm_m, _ = earth.radii(lat_m)
             lat, lat_m = _cumulative(lat0, vn / (rm + hgt), vn_m / (rm_m + hgt_m), h)
-        _, rn = earth.radii(lat)
-        _, rn_m = earth.radii(lat_m)
-        lon, _ = _cumulative(lon0, ve / ((rn + hgt) * np.cos(lat)), ve_m / ((rn_m + hgt_m) * np.cos(lat_m)), h)
+        sl, sl_m, cl = np.sin(lat), np.sin(lat_m), np.cos(lat)
+        _, rn = earth.radii(lat, sl)
+        _, rn_m = earth.radii(lat_m, sl_m)
+        lon, _ = _cumulative(lon0, ve / ((rn + hgt) * cl), ve_m / ((rn_m + hgt_m) * np.cos(lat_m)), h)
 
-        truth = self._assemble(t, cn, speed, gamma, psi, rollx, lat, lon, hgt)
+        k = slice(skip, None)  # views: the truth is formed sample by sample
+        truth = self._assemble(t[k], {name: v[k] for name, v in cn.items()}, speed[k],
+                               Trig(*(x[k] for x in g_t)), Trig(*(x[k] for x in p_t)), rollx[k],
+                               np.stack([ve, vn, vu], axis=-1)[k], lat[k], sl[k], cl[k], rn[k], lon[k], hgt[k])
         end = np.array([speed[-1], gamma[-1], psi[-1], rollx[-1], lat[-1], lon[-1], hgt[-1]])
         return truth, end
 
-    def _assemble(self, t, cmd, speed, gamma, psi, rollx, lat, lon, hgt) -> TrajectoryTruth:
+    def _assemble(self, t, cmd, speed, gamma: Trig, psi: Trig, rollx, vel_enu, lat, sin_lat, cos_lat, rn, lon,
+                  hgt) -> TrajectoryTruth:
         gamma_dot, psi_dot = cmd["pitch_rate"], cmd["turn_rate"]
-        cg, sg = np.cos(gamma), np.sin(gamma)
-        cp, sp = np.cos(psi), np.sin(psi)
+        cg, sg, cp, sp = gamma.cos, gamma.sin, psi.cos, psi.sin
         if self.cfg.coordinated_turns:
             num = speed * psi_dot * cg
             num_dot = (cmd["accel"] * psi_dot * cg + speed * cmd["turn_accel"] * cg - speed * psi_dot * sg * gamma_dot)
@@ -135,20 +143,18 @@ class Trajectory:
         roll = bank + rollx
         roll_dot = bank_dot + cmd["roll_rate"]
 
-        vel_enu = np.stack([speed * cg * sp, speed * cg * cp, speed * sg], axis=-1)
         acc_enu = (cmd["accel"][:, None] * np.stack([cg * sp, cg * cp, sg], -1)
                    + (speed * gamma_dot)[:, None] * np.stack([-sg * sp, -sg * cp, cg], -1)
                    + (speed * psi_dot)[:, None] * np.stack([cg * cp, -cg * sp, np.zeros_like(t)], -1))
 
-        rot = Rotation.from_quat(frames.quat_from_euler(gamma, roll, psi))
-        w_nb = body_rate_nb(gamma, roll, gamma_dot, roll_dot, psi_dot)
-        w_ie = earth.earth_rate_enu(lat)
-        w_en = earth.transport_rate_enu(lat, hgt, vel_enu)
-        omega_ib_b = w_nb + rot.inv().apply(w_ie + w_en)
-        f_n = acc_enu + np.cross(2.0 * w_ie + w_en, vel_enu) - earth.gravity_enu(lat, hgt)
-        f_ib_b = rot.inv().apply(f_n)
+        w_ie = earth.earth_rate_enu(lat, sin_lat, cos_lat)
+        w_en = earth.transport_rate_enu(lat, hgt, vel_enu, sin_lat)
+        f_n = acc_enu + np.cross(2.0 * w_ie + w_en, vel_enu) - earth.gravity_enu(lat, hgt, sin_lat)
+        quat_nb, euler, omega_ib_b, f_ib_b = body_truth(gamma, trig(roll), psi, (gamma_dot, roll_dot, psi_dot),
+                                                        w_ie + w_en, f_n)
 
         pos_lla = np.stack([lat, lon, hgt], axis=-1)
-        return TrajectoryTruth(t=t, pos_ecef=frames.lla_to_ecef(lat, lon, hgt), pos_lla=pos_lla, vel_enu=vel_enu,
-                     quat_nb=rot.as_quat(), euler=frames.euler_from_attitude(rot), omega_ib_b=omega_ib_b,
-                     f_ib_b=f_ib_b)
+        r_cos = (rn + hgt) * cos_lat  # geodetic -> ECEF with the prime-vertical radius rn at hand
+        pos_ecef = np.stack([r_cos * np.cos(lon), r_cos * np.sin(lon), (rn * (1.0 - earth.E2) + hgt) * sin_lat], -1)
+        return TrajectoryTruth(t=t, pos_ecef=pos_ecef, pos_lla=pos_lla, vel_enu=vel_enu,
+                               quat_nb=quat_nb, euler=euler, omega_ib_b=omega_ib_b, f_ib_b=f_ib_b)

@@ -23,12 +23,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .. import earth, frames
 from ..earth import G0
 from ..errors import DataFileError
-from .truth import TrajectoryTruth, body_rate_nb
+from .truth import TrajectoryTruth, body_truth, trig
 
 ATTITUDE_RULES = ("log", "ground", "coordinated")
 MIN_POINTS = 4
@@ -314,12 +313,12 @@ class LoggedPath:
                 roll_dot = G0 * q_dot / (G0**2 + q**2)
             else:
                 roll = roll_dot = np.zeros_like(t)
-        rot = Rotation.from_quat(frames.quat_from_euler(gamma, roll, psi))
         w_ie = earth.earth_rate_enu(lat)
-        omega = body_rate_nb(gamma, roll, gamma_dot, roll_dot, psi_dot) + rot.inv().apply(w_ie + w_en)
         f_n = a_n + np.cross(2.0 * w_ie + w_en, v_n) - earth.gravity_enu(lat, hgt)
-        return TrajectoryTruth(t=t, pos_ecef=r_e, pos_lla=lla, vel_enu=v_n, quat_nb=rot.as_quat(),
-                               euler=frames.euler_from_attitude(rot), omega_ib_b=omega, f_ib_b=rot.inv().apply(f_n))
+        quat, euler, omega, f_b = body_truth(trig(gamma), trig(roll), trig(psi), (gamma_dot, roll_dot, psi_dot),
+                                             w_ie + w_en, f_n)
+        return TrajectoryTruth(t=t, pos_ecef=r_e, pos_lla=lla, vel_enu=v_n, quat_nb=quat, euler=euler,
+                               omega_ib_b=omega, f_ib_b=f_b)
 
 
 def _velocity_angles(v_n, a_n):
