@@ -164,7 +164,7 @@ def test_package_import_graph_is_acyclic():
 # Derived from the code: io needs no stage, validation (observability) needs only the geometry below it and is
 # used by attitude (ATDOP), ambiguity needs nothing but errors.
 LAYERS = [
-    {"errors", "version", "atomic", "rng", "gpstime", "processes", "earth", "solution", "quat", "jitcache"},
+    {"errors", "version", "atomic", "rng", "gpstime", "processes", "earth", "solution", "quat", "jitcache", "alloc"},
     {"frames", "section", "params"},
     {"trajectory", "imu", "constellation", "environment"},
     {"gnss"},

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import frames, gpstime, rng
+from .. import alloc, frames, gpstime, rng
 from ..constellation import Sky, antenna_view, time_offsets
 from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
@@ -57,6 +57,7 @@ class GnssSimulator:
 
     def __init__(self, cfg: GnssConfig, sky: Sky, start_week: int, start_sow: float, seed: int,
                  duration_s: float, environment: Environment | None = None):
+        alloc.retain_freed_memory()  # blocks of ~60 MB of arrays: reuse the freed pages (simkit/alloc.py)
         self.cfg, self.sky, self.env = cfg, sky, environment
         self.start_week, self.start_sow = int(start_week), float(start_sow)
         self.duration_s = float(duration_s)
