@@ -37,6 +37,7 @@ from .ephemeris_errors import EphemerisErrors, rac_axes
 from .ionex import read_ionex
 from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
+from .orbit_range import range_errors
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
 from .tropo_truth import TruthTroposphere
@@ -327,19 +328,17 @@ class _Parts:
         pos, vel = np.nan_to_num(ref["sat_pos"][:, cand]), np.nan_to_num(ref["sat_vel"][:, cand])
         v_in = vel + np.cross(EARTH_RATE_ECEF, pos)
         rel = vel[:, None] - ant_vel[:, :, None]          # d(satellite - antenna)/dt in the rotating frame
-        diff = view.los * view.range[..., None]
         rac, rac_rate = e[:, cand, :3], e_rate[:, cand, :3]
-
-        def at(s):
+        h = 0.5
+        steps = np.array([0.0, h, -h])
+        d = np.empty((steps.size,) + pos.shape)                                          # (3, M, C, 3) ECEF
+        for j, s in enumerate(steps):
             with np.errstate(invalid="ignore"):
                 axes = rac_axes(pos + s * vel, v_in)                                     # (M, C, 3, 3)
-            d = np.einsum("mcki,mck->mci", axes, rac + s * rac_rate)
-            x = diff + s * rel
-            return np.linalg.norm(x + d[:, None], axis=-1) - np.linalg.norm(x, axis=-1)
-
-        h = 0.5
-        self.orb = at(0.0)
-        self.orb_rate = (at(h) - at(-h)) / (2.0 * h)
+            d[j] = np.einsum("mcki,mck->mci", axes, rac + s * rac_rate)
+        orb = range_errors(view.los, view.range, rel, d, steps)                         # (3, M, A, C)
+        self.orb = orb[0]
+        self.orb_rate = (orb[1] - orb[2]) / (2.0 * h)
         self.range, self.range_rate = view.range + self.orb, view.range_rate + self.orb_rate
 
     def _troposphere(self, err):
