@@ -14,6 +14,7 @@ import numpy as np
 
 from .. import frames, gpstime
 from ..earth import C_LIGHT, OMEGA_E
+from .light_time import back_light_time, light_time_step, rotated_view
 from .model import Constellation
 
 LIGHT_TIME_ITERATIONS = 3  # each iteration shrinks the error by ~v_sat/c: 3 take 75 ms to < 1e-9 m
@@ -76,14 +77,11 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
         rx = np.broadcast_to(rx, (m, 3))
     week_ms = np.broadcast_to(week[:, None], (m, s))
     tau, tw, ts, out = _emission(const, rx, week_ms, sow, velocity)
-    pos = _rotate_z(out[0], OMEGA_E * tau)
-    diff = pos - rx[:, None, :]
-    rng = np.linalg.norm(diff, axis=-1)
-    los = diff / rng[..., None]
+    pos, vel, rng, los = rotated_view(out[0], out[2] if velocity else None, rx, tau)
     el, az = elevation_azimuth(rx, los)
     return Geometry(
         tx_week=np.asarray(tw), tx_sow=np.where(np.isfinite(rng), ts, np.nan), sat_pos=pos,
-        sat_vel=_rotate_z(out[2], OMEGA_E * tau) if velocity else None, sat_clock=out[1],
+        sat_vel=vel, sat_clock=out[1],
         sat_drift=out[3] if velocity else None, range=rng, tau=rng / C_LIGHT, los=los, elevation=el, azimuth=az,
         sat_pos_emission=out[0],
     )
@@ -100,16 +98,11 @@ def _emission(const, rx, week_ms, sow, velocity):
     below 1e-21 m). Entries whose step is still above :data:`REFINE_S` (no state at reception, near the
     end of a record's validity) are evaluated again at the new time, at most LIGHT_TIME_ITERATIONS times."""
     now = const.state_each(week_ms, np.broadcast_to(sow[:, None], week_ms.shape), velocity=True)
-    tau = np.full(week_ms.shape, TAU_START_S)
-    for _ in range(LIGHT_TIME_ITERATIONS):
-        back = _rotate_z(now[0] - now[2] * tau[..., None], OMEGA_E * tau)
-        tau = np.linalg.norm(back - rx[:, None, :], axis=-1) / C_LIGHT
-        tau = np.where(np.isfinite(tau), tau, TAU_START_S)
+    tau = back_light_time(now[0], now[2], rx, TAU_START_S, LIGHT_TIME_ITERATIONS)
     tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
     out = [np.array(x) for x in const.state_each(tw, ts, velocity=True)]
     for i in range(LIGHT_TIME_ITERATIONS + 1):
-        new = np.linalg.norm(_rotate_z(out[0], OMEGA_E * tau) - rx[:, None, :], axis=-1) / C_LIGHT
-        step = np.where(np.isfinite(new), new - tau, 0.0)
+        step = light_time_step(out[0], rx, tau)
         far = np.abs(step) > REFINE_S
         if i == LIGHT_TIME_ITERATIONS or not far.any():
             break

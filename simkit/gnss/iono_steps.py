@@ -22,18 +22,18 @@ _HALF_PI = 0.5 * math.pi
 _POLE_LAT = math.radians(70.0)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, inline="always", error_model="numpy")
 def _clip(x, lo, hi):
     """np.clip for a scalar (NaN stays NaN)."""
     return lo if x < lo else (hi if x > hi else x)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, inline="always", error_model="numpy")
 def _poly(c, x):
     return c[0] + x * (c[1] + x * (c[2] + x * c[3]))
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, inline="always", error_model="numpy")
 def _klobuchar_gps(alpha, beta, lat, lon, az, el, tow_s):
     """:func:`simkit.gnss.atmosphere.klobuchar_gps` for one line of sight (m on L1)."""
     e = el / math.pi
@@ -54,7 +54,7 @@ def _klobuchar_gps(alpha, beta, lat, lon, az, el, tow_s):
     return C_LIGHT * f * night
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, inline="always", error_model="numpy")
 def _klobuchar_bds(alpha, beta, lat, lon, az, el, bdt_tow_s):
     """:func:`simkit.gnss.atmosphere.klobuchar_bds` for one line of sight (m on B1I)."""
     k = 6378.0e3 / (6378.0e3 + 375.0e3) * math.cos(el)
@@ -70,7 +70,7 @@ def _klobuchar_bds(alpha, beta, lat, lon, az, el, bdt_tow_s):
     return C_LIGHT * iz / math.sqrt(1.0 - k**2)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, inline="always", error_model="numpy")
 def _pierce(lat, lon, az, el, shell_ratio):
     """:func:`simkit.gnss.iono_truth.pierce_point` for one line of sight: (lat_p, lon_p) rad."""
     rp = shell_ratio * math.cos(el)
@@ -83,7 +83,7 @@ def _pierce(lat, lon, az, el, shell_ratio):
     return lat_p, (lon + math.pi - d if over_pole else lon + d)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _steps(bds, alpha, beta, lat, lon, lat_rate, lon_rate, az, el, az_rate, el_rate, sow, steps, shell_ratio,
            shell_r, klob, points):
     for m in range(az.shape[0]):
