@@ -14,12 +14,14 @@ import numpy as np
 
 from .. import frames, gpstime
 from ..earth import C_LIGHT, OMEGA_E
-from .light_time import back_light_time, light_time_step, rotated_view
+from .light_time import back_light_time, hermite_states, light_time_step, rotated_view
 from .model import Constellation
 
 LIGHT_TIME_ITERATIONS = 3  # each iteration shrinks the error by ~v_sat/c: 3 take 75 ms to < 1e-9 m
 REFINE_S = 1e-9  # a last light-time step above this (s) re-evaluates the broadcast state (see _emission)
 TAU_START_S = 0.075  # start of the iteration: about a MEO's light time (20,000 km)
+RECEPTION_GRID = 30  # epochs between broadcast evaluations of the states that start the iteration
+MAX_GRID_GAP_S = 120.0  # largest time between those evaluations (else every epoch is evaluated)
 
 
 @dataclass
@@ -97,8 +99,7 @@ def _emission(const, rx, week_ms, sow, velocity):
     d = tau' - tau along its own velocity and clock drift (|d| < 1e-11 s: the neglected acceleration term is
     below 1e-21 m). Entries whose step is still above :data:`REFINE_S` (no state at reception, near the
     end of a record's validity) are evaluated again at the new time, at most LIGHT_TIME_ITERATIONS times."""
-    now = const.state_each(week_ms, np.broadcast_to(sow[:, None], week_ms.shape), velocity=True)
-    tau = back_light_time(now[0], now[2], rx, TAU_START_S, LIGHT_TIME_ITERATIONS)
+    tau = back_light_time(*_reception_states(const, week_ms, sow), rx, TAU_START_S, LIGHT_TIME_ITERATIONS)
     tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
     out = [np.array(x) for x in const.state_each(tw, ts, velocity=True)]
     for i in range(LIGHT_TIME_ITERATIONS + 1):
@@ -116,6 +117,23 @@ def _emission(const, rx, week_ms, sow, velocity):
     tau = tau + step
     tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
     return tau, tw, ts, tuple(out) if velocity else (out[0], out[1])
+
+
+def _reception_states(const, week_ms, sow):
+    """Satellite positions and velocities (M, S, 3) at the reception times, which only start the light-time
+    iteration: from the broadcast orbits every :data:`RECEPTION_GRID` epochs and cubic Hermite interpolation
+    between (3e-7 m for a MEO 30 s apart, 3e-15 s of light time), when the epochs increase with gaps of at most
+    :data:`MAX_GRID_GAP_S` between grid epochs; else at every epoch. A state wrong by more than c REFINE_S (a
+    record changing between grid epochs) costs only an extra evaluation in :func:`_emission`."""
+    m = sow.size
+    t = (week_ms[:, 0] - week_ms[0, 0]) * gpstime.SECONDS_PER_WEEK + (sow - sow[0])
+    rows = np.unique(np.r_[np.arange(0, m, RECEPTION_GRID), m - 1])
+    if m < 2 * RECEPTION_GRID or np.any(np.diff(t) <= 0.0) or np.diff(t[rows]).max() > MAX_GRID_GAP_S:
+        now = const.state_each(week_ms, np.broadcast_to(sow[:, None], week_ms.shape), velocity=True)
+        return now[0], now[2]
+    grid = const.state_each(week_ms[rows], np.broadcast_to(sow[rows, None], (rows.size, week_ms.shape[1])),
+                            velocity=True)
+    return hermite_states(t[rows], grid[0], grid[2], t)
 
 
 def elevation_azimuth(rx_pos, los):

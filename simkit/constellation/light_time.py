@@ -90,3 +90,32 @@ def rotated_view(pos_e, vel_e, rx, tau):
     rng, los = np.empty(pos_e.shape[:2]), np.empty_like(pos_e)
     _view(pos_e, vel_e, rx, tau, pos, vel, rng, los)
     return pos, (vel if vel.shape[0] else None), rng, los
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _hermite(t_grid, pos_g, vel_g, t, pos, vel):
+    k = 0
+    for m in range(t.shape[0]):
+        while k < t_grid.shape[0] - 2 and t[m] > t_grid[k + 1]:
+            k += 1
+        h = t_grid[k + 1] - t_grid[k]
+        x = (t[m] - t_grid[k]) / h
+        x2, x3 = x * x, x * x * x
+        h00, h10, h01, h11 = 2.0 * x3 - 3.0 * x2 + 1.0, x3 - 2.0 * x2 + x, 3.0 * x2 - 2.0 * x3, x3 - x2
+        d00, d10, d01, d11 = (6.0 * x2 - 6.0 * x) / h, 3.0 * x2 - 4.0 * x + 1.0, (6.0 * x - 6.0 * x2) / h, \
+            3.0 * x2 - 2.0 * x
+        for s in range(pos_g.shape[1]):
+            for i in range(3):
+                p0, p1, v0, v1 = pos_g[k, s, i], pos_g[k + 1, s, i], vel_g[k, s, i], vel_g[k + 1, s, i]
+                pos[m, s, i] = h00 * p0 + h10 * h * v0 + h01 * p1 + h11 * h * v1
+                vel[m, s, i] = d00 * p0 + d10 * v0 + d01 * p1 + d11 * v1
+
+
+def hermite_states(t_grid, pos_g, vel_g, t):
+    """Positions and velocities (M, S, 3) at times ``t`` (M,) s, increasing, by cubic Hermite interpolation of
+    states ``pos_g`` (G, S, 3) m and ``vel_g`` (G, S, 3) m/s at the increasing times ``t_grid`` (G,) s, G >= 2,
+    which span ``t``; NaN where a neighbouring state is NaN."""
+    t_grid, pos_g, vel_g, t = (np.ascontiguousarray(x, dtype=float) for x in (t_grid, pos_g, vel_g, t))
+    pos, vel = np.empty((t.size,) + pos_g.shape[1:]), np.empty((t.size,) + pos_g.shape[1:])
+    _hermite(t_grid, pos_g, vel_g, t, pos, vel)
+    return pos, vel
