@@ -79,8 +79,9 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
         rx = np.broadcast_to(rx, (m, 3))
     week_ms = np.broadcast_to(week[:, None], (m, s))
     tau, tw, ts, out = _emission(const, rx, week_ms, sow, velocity)
-    pos, vel, rng, los = rotated_view(out[0], out[2] if velocity else None, rx, tau)
-    el, az = elevation_azimuth(rx, los)
+    lla = frames.ecef_to_lla(rx)
+    pos, vel, rng, los, el, az = rotated_view(out[0], out[2] if velocity else None, rx, tau,
+                                              frames.ecef_to_enu_matrix(lla[:, 0], lla[:, 1]))
     return Geometry(
         tx_week=np.asarray(tw), tx_sow=np.where(np.isfinite(rng), ts, np.nan), sat_pos=pos,
         sat_vel=vel, sat_clock=out[1],

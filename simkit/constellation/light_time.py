@@ -47,8 +47,9 @@ def _step(pos, rx, tau, step):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _view(pos_e, vel_e, rx, tau, pos, vel, rng, los):
+def _view(pos_e, vel_e, rx, c_en, tau, pos, vel, rng, los, el, az):
     for m in range(pos_e.shape[0]):
+        c = c_en[m]
         for s in range(pos_e.shape[1]):
             angle = OMEGA_E * tau[m, s]
             pos[m, s, 0], pos[m, s, 1] = _rotated(pos_e[m, s, 0], pos_e[m, s, 1], angle)
@@ -58,8 +59,13 @@ def _view(pos_e, vel_e, rx, tau, pos, vel, rng, los):
                 vel[m, s, 2] = vel_e[m, s, 2]
             dx, dy, dz = pos[m, s, 0] - rx[m, 0], pos[m, s, 1] - rx[m, 1], pos[m, s, 2] - rx[m, 2]
             r = math.sqrt(dx * dx + dy * dy + dz * dz)
+            u0, u1, u2 = dx / r, dy / r, dz / r
             rng[m, s] = r
-            los[m, s, 0], los[m, s, 1], los[m, s, 2] = dx / r, dy / r, dz / r
+            los[m, s, 0], los[m, s, 1], los[m, s, 2] = u0, u1, u2
+            up = c[2, 0] * u0 + c[2, 1] * u1 + c[2, 2] * u2
+            el[m, s] = math.asin(min(max(up, -1.0), 1.0)) if up == up else up
+            az[m, s] = math.atan2(c[0, 0] * u0 + c[0, 1] * u1 + c[0, 2] * u2,
+                                  c[1, 0] * u0 + c[1, 1] * u1 + c[1, 2] * u2) % (2.0 * math.pi)
 
 
 def back_light_time(pos, vel, rx, tau_start: float, iterations: int) -> np.ndarray:
@@ -80,16 +86,18 @@ def light_time_step(pos, rx, tau) -> np.ndarray:
     return step
 
 
-def rotated_view(pos_e, vel_e, rx, tau):
+def rotated_view(pos_e, vel_e, rx, tau, c_en):
     """Satellites at emission (``pos_e`` (M, S, 3) m, ``vel_e`` (M, S, 3) m/s or None, ECEF of emission) rotated
     by Omega_e ``tau`` into the ECEF frame of reception: (pos, vel or None, range (M, S) m, los (M, S, 3) unit
-    vectors from receivers ``rx`` (M, 3) m)."""
-    pos_e, rx, tau = (np.ascontiguousarray(x, dtype=float) for x in (pos_e, rx, tau))
+    vectors from receivers ``rx`` (M, 3) m, elevation and azimuth (M, S) rad in the receivers' ENU frames given
+    by ``c_en`` (M, 3, 3) (ECEF to ENU), azimuth clockwise from north in [0, 2 pi))."""
+    pos_e, rx, tau, c_en = (np.ascontiguousarray(x, dtype=float) for x in (pos_e, rx, tau, c_en))
     vel_e = np.zeros((0, 0, 3)) if vel_e is None else np.ascontiguousarray(vel_e, dtype=float)
     pos, vel = np.empty_like(pos_e), np.empty(vel_e.shape)
     rng, los = np.empty(pos_e.shape[:2]), np.empty_like(pos_e)
-    _view(pos_e, vel_e, rx, tau, pos, vel, rng, los)
-    return pos, (vel if vel.shape[0] else None), rng, los
+    el, az = np.empty(pos_e.shape[:2]), np.empty(pos_e.shape[:2])
+    _view(pos_e, vel_e, rx, c_en, tau, pos, vel, rng, los, el, az)
+    return pos, (vel if vel.shape[0] else None), rng, los, el, az
 
 
 @numba.njit(cache=True, error_model="numpy")
