@@ -33,7 +33,7 @@ from . import atmosphere, noise, signals as sigmod, tworay
 from .clock import ClockProcess
 from .config import GnssConfig, check_sats, code_scale_at
 from .draws import KeyedNormals
-from .ephemeris_errors import EphemerisErrors, rac_axes
+from .ephemeris_errors import EphemerisErrors
 from .ionex import read_ionex
 from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
@@ -330,13 +330,7 @@ class _Parts:
         rel = vel[:, None] - ant_vel[:, :, None]          # d(satellite - antenna)/dt in the rotating frame
         rac, rac_rate = e[:, cand, :3], e_rate[:, cand, :3]
         h = 0.5
-        steps = np.array([0.0, h, -h])
-        d = np.empty((steps.size,) + pos.shape)                                          # (3, M, C, 3) ECEF
-        for j, s in enumerate(steps):
-            with np.errstate(invalid="ignore"):
-                axes = rac_axes(pos + s * vel, v_in)                                     # (M, C, 3, 3)
-            d[j] = np.einsum("mcki,mck->mci", axes, rac + s * rac_rate)
-        orb = range_errors(view.los, view.range, rel, d, steps)                         # (3, M, A, C)
+        orb = range_errors(view.los, view.range, rel, pos, vel, v_in, rac, rac_rate, np.array([0.0, h, -h]))
         self.orb = orb[0]
         self.orb_rate = (orb[1] - orb[2]) / (2.0 * h)
         self.range, self.range_rate = view.range + self.orb, view.range_rate + self.orb_rate
