@@ -59,11 +59,11 @@ def test_light_time_solution_equals_the_converged_light_time_equation(systems):
 def test_dense_epochs_started_from_interpolated_states_equal_the_converged_equation(systems):
     """1 Hz epochs of a receiver flying at 250 m/s across the GPS and BDS record changes at 01:00 and 00:30/01:30
     GPST (a record switching between the broadcast evaluations at reception): the states that start the iteration
-    are interpolated (geometry.RECEPTION_GRID), the result still that of the converged equation."""
+    are interpolated (geometry.RECEPTION_GRID_S), the result still that of the converged equation."""
     const = load(BRDM, systems=systems)
     n = 3900
     sow = 86400.0 + 1500.0 + np.arange(n, dtype=float)          # 00:25 to 01:30 GPST
-    assert n >= 2 * geometry.RECEPTION_GRID
+
     lat = np.radians(34.2) + np.arange(n) * 250.0 / 6.37e6
     rx = frames.lla_to_ecef(lat, np.full(n, np.radians(108.9)), np.full(n, 9000.0))
     week = np.full(n, 2416)
@@ -72,7 +72,7 @@ def test_dense_epochs_started_from_interpolated_states_equal_the_converged_equat
     const.state_each = lambda w, s, velocity=False: evaluated.append(np.shape(s)) or state_each(w, s, velocity)
     geo = receiver_view(const, rx, week, sow, velocity=True)
     const.state_each = state_each
-    assert evaluated[0][0] == n // geometry.RECEPTION_GRID + 1      # the grid, not every epoch
+    assert evaluated[0][0] == n // geometry.RECEPTION_GRID_S + 1    # the grid, not every epoch
     pos, clk, rng = _converged(const, rx, week, sow)
     known = np.isfinite(pos[..., 0])
     assert np.array_equal(known, np.isfinite(geo.sat_pos_emission[..., 0])) and known.sum() > 10 * n

@@ -20,8 +20,7 @@ from .model import Constellation
 LIGHT_TIME_ITERATIONS = 3  # each iteration shrinks the error by ~v_sat/c: 3 take 75 ms to < 1e-9 m
 REFINE_S = 1e-9  # a last light-time step above this (s) re-evaluates the broadcast state (see _emission)
 TAU_START_S = 0.075  # start of the iteration: about a MEO's light time (20,000 km)
-RECEPTION_GRID = 30  # epochs between broadcast evaluations of the states that start the iteration
-MAX_GRID_GAP_S = 120.0  # largest time between those evaluations (else every epoch is evaluated)
+RECEPTION_GRID_S = 30  # s of GPS time between the broadcast states that start the iteration (interpolated)
 
 
 @dataclass
@@ -122,19 +121,21 @@ def _emission(const, rx, week_ms, sow, velocity):
 
 def _reception_states(const, week_ms, sow):
     """Satellite positions and velocities (M, S, 3) at the reception times, which only start the light-time
-    iteration: from the broadcast orbits every :data:`RECEPTION_GRID` epochs and cubic Hermite interpolation
-    between (3e-7 m for a MEO 30 s apart, 3e-15 s of light time), when the epochs increase with gaps of at most
-    :data:`MAX_GRID_GAP_S` between grid epochs; else at every epoch. A state wrong by more than c REFINE_S (a
-    record changing between grid epochs) costs only an extra evaluation in :func:`_emission`."""
-    m = sow.size
-    t = (week_ms[:, 0] - week_ms[0, 0]) * gpstime.SECONDS_PER_WEEK + (sow - sow[0])
-    rows = np.unique(np.r_[np.arange(0, m, RECEPTION_GRID), m - 1])
-    if m < 2 * RECEPTION_GRID or np.any(np.diff(t) <= 0.0) or np.diff(t[rows]).max() > MAX_GRID_GAP_S:
-        now = const.state_each(week_ms, np.broadcast_to(sow[:, None], week_ms.shape), velocity=True)
-        return now[0], now[2]
-    grid = const.state_each(week_ms[rows], np.broadcast_to(sow[rows, None], (rows.size, week_ms.shape[1])),
-                            velocity=True)
-    return hermite_states(t[rows], grid[0], grid[2], t)
+    iteration: cubic Hermite interpolation between broadcast states on a fixed grid of GPS time, every
+    :data:`RECEPTION_GRID_S` s (3e-7 m for a MEO, 3e-15 s of light time), evaluated only at the grid times that
+    bracket an epoch. The grid is absolute, so an epoch's states do not depend on the other epochs of the call
+    (files do not depend on the block split). A state wrong by more than c REFINE_S (a record changing between
+    grid times) costs only an extra evaluation in :func:`_emission`."""
+    per_week = int(gpstime.SECONDS_PER_WEEK) // RECEPTION_GRID_S
+    week = week_ms[:, 0].astype(np.int64)
+    node = week * per_week + np.floor(sow / RECEPTION_GRID_S).astype(np.int64)         # the grid time at or before
+    nodes = np.unique(np.concatenate([node, node + 1]))
+    n_week, n_sow = nodes // per_week, (nodes % per_week) * float(RECEPTION_GRID_S)
+    grid = const.state_each(np.broadcast_to(n_week[:, None], (nodes.size, week_ms.shape[1])),
+                            np.broadcast_to(n_sow[:, None], (nodes.size, week_ms.shape[1])), velocity=True)
+    k = np.searchsorted(nodes, node)
+    x = ((week - n_week[k]) * gpstime.SECONDS_PER_WEEK + (sow - n_sow[k])) / RECEPTION_GRID_S
+    return hermite_states(k, x, float(RECEPTION_GRID_S), grid[0], grid[2])
 
 
 def elevation_azimuth(rx_pos, los):

@@ -101,29 +101,27 @@ def rotated_view(pos_e, vel_e, rx, tau, c_en):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _hermite(t_grid, pos_g, vel_g, t, pos, vel):
-    k = 0
-    for m in range(t.shape[0]):
-        while k < t_grid.shape[0] - 2 and t[m] > t_grid[k + 1]:
-            k += 1
-        h = t_grid[k + 1] - t_grid[k]
-        x = (t[m] - t_grid[k]) / h
-        x2, x3 = x * x, x * x * x
-        h00, h10, h01, h11 = 2.0 * x3 - 3.0 * x2 + 1.0, x3 - 2.0 * x2 + x, 3.0 * x2 - 2.0 * x3, x3 - x2
-        d00, d10, d01, d11 = (6.0 * x2 - 6.0 * x) / h, 3.0 * x2 - 4.0 * x + 1.0, (6.0 * x - 6.0 * x2) / h, \
-            3.0 * x2 - 2.0 * x
+def _hermite(k, x, h, pos_g, vel_g, pos, vel):
+    for m in range(k.shape[0]):
+        xm = x[m]
+        x2, x3 = xm * xm, xm * xm * xm
+        h00, h10, h01, h11 = 2.0 * x3 - 3.0 * x2 + 1.0, x3 - 2.0 * x2 + xm, 3.0 * x2 - 2.0 * x3, x3 - x2
+        d00, d10 = (6.0 * x2 - 6.0 * xm) / h, 3.0 * x2 - 4.0 * xm + 1.0
+        d01, d11 = (6.0 * xm - 6.0 * x2) / h, 3.0 * x2 - 2.0 * xm
+        g = k[m]
         for s in range(pos_g.shape[1]):
             for i in range(3):
-                p0, p1, v0, v1 = pos_g[k, s, i], pos_g[k + 1, s, i], vel_g[k, s, i], vel_g[k + 1, s, i]
+                p0, p1, v0, v1 = pos_g[g, s, i], pos_g[g + 1, s, i], vel_g[g, s, i], vel_g[g + 1, s, i]
                 pos[m, s, i] = h00 * p0 + h10 * h * v0 + h01 * p1 + h11 * h * v1
                 vel[m, s, i] = d00 * p0 + d10 * v0 + d01 * p1 + d11 * v1
 
 
-def hermite_states(t_grid, pos_g, vel_g, t):
-    """Positions and velocities (M, S, 3) at times ``t`` (M,) s, increasing, by cubic Hermite interpolation of
-    states ``pos_g`` (G, S, 3) m and ``vel_g`` (G, S, 3) m/s at the increasing times ``t_grid`` (G,) s, G >= 2,
-    which span ``t``; NaN where a neighbouring state is NaN."""
-    t_grid, pos_g, vel_g, t = (np.ascontiguousarray(x, dtype=float) for x in (t_grid, pos_g, vel_g, t))
-    pos, vel = np.empty((t.size,) + pos_g.shape[1:]), np.empty((t.size,) + pos_g.shape[1:])
-    _hermite(t_grid, pos_g, vel_g, t, pos, vel)
+def hermite_states(k, x, h: float, pos_g, vel_g):
+    """Positions and velocities (M, S, 3) by cubic Hermite interpolation between the states ``pos_g`` (G, S, 3) m,
+    ``vel_g`` (G, S, 3) m/s at nodes ``h`` s apart: epoch m lies at the fraction ``x`` (M,) of the way from node
+    ``k`` (M,) int to node k + 1. NaN where either node's state is NaN."""
+    k = np.ascontiguousarray(k, dtype=np.int64)
+    x, pos_g, vel_g = (np.ascontiguousarray(a, dtype=float) for a in (x, pos_g, vel_g))
+    pos, vel = np.empty((k.size,) + pos_g.shape[1:]), np.empty((k.size,) + pos_g.shape[1:])
+    _hermite(k, x, float(h), pos_g, vel_g, pos, vel)
     return pos, vel

@@ -37,6 +37,7 @@ from .ephemeris_errors import EphemerisErrors
 from .ionex import read_ionex
 from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
+from .columns import place_columns
 from .orbit_range import range_errors
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
@@ -283,6 +284,8 @@ class _Parts:
 
     def full(self, x, fill=np.nan):
         """(M, A, S) array with the candidate columns ``x`` and ``fill`` elsewhere."""
+        if np.asarray(x).dtype == np.float64:
+            return place_columns(x, self.cand, self.shape[2], fill=fill)
         out = np.full(self.shape, fill, dtype=np.asarray(x).dtype)
         out[..., self.cand] = x
         return out
@@ -416,9 +419,7 @@ class _Parts:
         keep = tracked[..., cols, j]
 
         def put(x, masked=False):
-            out = np.full(self.shape, np.nan)
-            out[..., cols] = np.where(keep, x, np.nan) if masked else x
-            return out
+            return place_columns(x, cols, self.shape[2], keep if masked else None)
 
         self.obs[g.name] = SignalObs(
             code=put(base + gd + iono + mp_c + n_c, True),
