@@ -70,7 +70,7 @@ def test_dense_epochs_started_from_interpolated_states_equal_the_converged_equat
     evaluated = []
     state_each = const.state_each
     const.state_each = lambda w, s, velocity=False: evaluated.append(np.shape(s)) or state_each(w, s, velocity)
-    geo = receiver_view(const, rx, week, sow, velocity=True)
+    geo = receiver_view(const, rx, week, sow, velocity=True, reception_grid=True)
     const.state_each = state_each
     assert evaluated[0][0] == n // geometry.RECEPTION_GRID_S + 1    # the grid, not every epoch
     pos, clk, rng = _converged(const, rx, week, sow)
@@ -81,3 +81,18 @@ def test_dense_epochs_started_from_interpolated_states_equal_the_converged_equat
     dc = np.abs(geo.sat_clock - clk)[known].max()
     print(f"\n{systems}: max |position| {dp:.1e} m, |range| {dr:.1e} m, |clock| {dc:.1e} s")
     assert dp < 3e-7 and dr < 1e-7 and dc < 1e-15
+
+
+def test_without_the_grid_every_epoch_starts_from_its_own_state():
+    """The default (sparse epochs: `simkit sky`, imports): the states at reception are evaluated at the epochs."""
+    const = load(BRDM, systems="G")
+    sow = 86400.0 + 600.0 * np.arange(20)
+    rx = np.broadcast_to(frames.lla_to_ecef(np.radians(34.2), np.radians(108.9), 400.0), (20, 3))
+    evaluated = []
+    state_each = const.state_each
+    const.state_each = lambda w, s, velocity=False: evaluated.append(np.shape(s)) or state_each(w, s, velocity)
+    plain = receiver_view(const, rx, np.full(20, 2416), sow, velocity=True)
+    const.state_each = state_each
+    assert evaluated[0][0] == 20
+    grid = receiver_view(const, rx, np.full(20, 2416), sow, velocity=True, reception_grid=True)
+    assert np.nanmax(np.abs(plain.range - grid.range)) < 1e-7

@@ -67,9 +67,14 @@ def sagnac_rotate(sat_pos: np.ndarray, receiver: np.ndarray) -> np.ndarray:
     return _rotate_z(sat_pos, OMEGA_E * tau)
 
 
-def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: bool = False) -> Geometry:
+def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: bool = False,
+                  reception_grid: bool = False) -> Geometry:
     """Emission times by light-time iteration with Earth rotation, for receivers at ``rx_pos`` (M, 3) m ECEF at
-    reception times (``gps_week`` scalar or (M,), ``gps_sow`` (M,) s GPS). Returns a :class:`Geometry`."""
+    reception times (``gps_week`` scalar or (M,), ``gps_sow`` (M,) s GPS). Returns a :class:`Geometry`.
+
+    ``reception_grid``: start the iteration from states interpolated on a 30 s grid of GPS time
+    (:func:`_reception_states`: for epochs a second apart, half the orbit evaluations); meant for dense epochs (a
+    receiver's run at 1 Hz or faster), not for sparse ones, where the grid would need more states than the epochs."""
     rx = np.atleast_2d(np.asarray(rx_pos, dtype=float))
     sow = np.atleast_1d(np.asarray(gps_sow, dtype=float))
     week = np.broadcast_to(np.asarray(gps_week), sow.shape)
@@ -77,7 +82,7 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
     if rx.shape != (m, 3):
         rx = np.broadcast_to(rx, (m, 3))
     week_ms = np.broadcast_to(week[:, None], (m, s))
-    tau, tw, ts, out = _emission(const, rx, week_ms, sow, velocity)
+    tau, tw, ts, out = _emission(const, rx, week_ms, sow, velocity, reception_grid)
     lla = frames.ecef_to_lla(rx)
     pos, vel, rng, los, el, az = rotated_view(out[0], out[2] if velocity else None, rx, tau,
                                               frames.ecef_to_enu_matrix(lla[:, 0], lla[:, 1]))
@@ -89,7 +94,7 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
     )
 
 
-def _emission(const, rx, week_ms, sow, velocity):
+def _emission(const, rx, week_ms, sow, velocity, reception_grid=False):
     """Light time tau (M, S) s, emission time (week, sow) and the satellite states there (``state_each``'s
     returns, with velocity and drift), for receivers ``rx`` (M, 3) at reception times.
 
@@ -99,7 +104,11 @@ def _emission(const, rx, week_ms, sow, velocity):
     d = tau' - tau along its own velocity and clock drift (|d| < 1e-11 s: the neglected acceleration term is
     below 1e-21 m). Entries whose step is still above :data:`REFINE_S` (no state at reception, near the
     end of a record's validity) are evaluated again at the new time, at most LIGHT_TIME_ITERATIONS times."""
-    tau = back_light_time(*_reception_states(const, week_ms, sow), rx, TAU_START_S, LIGHT_TIME_ITERATIONS)
+    if reception_grid:
+        now = _reception_states(const, week_ms, sow)
+    else:
+        now = const.state_each(week_ms, np.broadcast_to(sow[:, None], week_ms.shape), velocity=True)[::2]
+    tau = back_light_time(*now, rx, TAU_START_S, LIGHT_TIME_ITERATIONS)
     tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
     out = [np.array(x) for x in const.state_each(tw, ts, velocity=True)]
     for i in range(LIGHT_TIME_ITERATIONS + 1):

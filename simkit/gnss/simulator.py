@@ -26,6 +26,7 @@ import numpy as np
 
 from .. import alloc, frames, gpstime, rng
 from ..constellation import Sky, antenna_view, time_offsets
+from ..constellation.geometry import RECEPTION_GRID_S
 from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
 from ..errors import DataFileError, ScenarioError
@@ -192,7 +193,7 @@ class GnssSimulator:
         week, sow = gpstime.add_seconds(self.start_week, self.start_sow, t)
         ant_pos, ant_vel, c_be = frames.lever_arm_ecef(pos, np.asarray(vel_ecef, dtype=float).reshape(t.size, 3),
                                                        quat_nb, omega_ib_b, self.lever)
-        ref = self.sky.view(pos, week, sow)
+        ref = self.sky.view(pos, week, sow, reception_grid=self.cfg.rate_hz * RECEPTION_GRID_S >= 2.0)
         low = self.cfg.elevation_mask_rad if self.env is None else min(self.cfg.elevation_mask_rad, 0.0)
         with np.errstate(invalid="ignore"):
             cand = np.flatnonzero((ref["elevation"] >= low - _MASK_MARGIN_RAD).any(axis=0))
