@@ -6,7 +6,7 @@ import pyrtklib as rtk
 
 from simkit.gnss import atmosphere
 from simkit.gnss.iono_steps import klobuchar_and_pierce_points
-from simkit.gnss.iono_truth import SHELL_HEIGHT_M, SHELL_RADIUS_M, TruthIonosphere, pierce_point
+from simkit.gnss.iono_truth import SHELL_HEIGHT_M, SHELL_RADIUS_M, pierce_point
 from simkit.gpstime import BDT_MINUS_GPST
 
 STEPS = np.array([-0.05, 0.0, 0.05])
@@ -94,38 +94,3 @@ def test_bds_uses_bdt_and_the_bds_shell():
     klob, _ = _kernel("C", BDS, g)
     want = atmosphere.klobuchar_bds(*BDS, lat[..., None], lon[..., None], az, el, sow[:, None, None] + BDT_MINUS_GPST)
     assert np.nanmax(np.abs(klob[:, :, 1] - want)) < 1e-12
-
-
-def test_truth_delay_for_bds_equals_the_closed_form_field():
-    """The truth delay and rate through the compiled pass against the field summed term by term at numpy's
-    Klobuchar and pierce points (the BDS twin of test_gnss_feature_sum's GPS case)."""
-    truth = TruthIonosphere(11, 0.5, 1000e3, 3600.0)
-    rs = np.random.default_rng(4)
-    m, c, h = 20, 7, 0.05
-    lla = np.zeros((m, 3, 3))
-    lla[..., 0], lla[..., 1], lla[..., 2] = np.radians(34.2), np.radians(108.9) + np.arange(3) * 1e-6, 400.0
-    vel = np.zeros_like(lla)
-    vel[..., :2] = rs.normal(0.0, 30.0, (m, 1, 2))
-    az, el = rs.uniform(0, 2 * np.pi, (m, 3, c)), rs.uniform(0.2, 1.5, (m, 3, c))
-    az_rate, el_rate = rs.normal(0, 1e-4, (m, 3, c)), rs.normal(0, 1e-4, (m, 3, c))
-    sow = (86400.0 + 30.0 * np.arange(m))[:, None, None]
-    iono, rate, klob = truth.delay("C", *BDS, lla, vel, az, el, az_rate, el_rate, np.full_like(sow, 2416), sow,
-                                   sow - 86400.0, h)
-    from simkit import earth
-
-    lat, lon, hgt = lla[..., 0, None], lla[..., 1, None], lla[..., 2, None]
-    rm, rn = earth.radii(lat)
-    lat_rate, lon_rate = vel[..., 1, None] / (rm + hgt), vel[..., 0, None] / ((rn + hgt) * np.cos(lat))
-    f = truth.field
-
-    def exact(s):
-        la, lo, a, e = lat + s * lat_rate, lon + s * lon_rate, az + s * az_rate, el + s * el_rate
-        lat_p, lon_p = pierce_point(la, lo, a, e)
-        r = SHELL_RADIUS_M + SHELL_HEIGHT_M
-        x = np.stack([r * np.cos(lat_p) * np.cos(lon_p), r * np.cos(lat_p) * np.sin(lon_p), r * np.sin(lat_p)], -1)
-        field = f.scale * np.cos(x @ f.k.T + (sow - 86400.0 + s)[..., None] * f.w + f.phase).sum(-1)
-        k = atmosphere.broadcast_ionosphere("C", *BDS, la, lo, a, e, sow + s)
-        return k * np.exp(truth.sigma * field - 0.5 * truth.sigma**2), k
-
-    assert np.abs(iono - exact(0.0)[0]).max() < 1e-9 and np.abs(klob - exact(0.0)[1]).max() < 1e-12
-    assert np.abs(rate - (exact(h)[0] - exact(-h)[0]) / (2 * h)).max() < 1e-9
