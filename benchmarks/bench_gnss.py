@@ -46,6 +46,9 @@ def scenario(hours: float):
 def ours(hours: float, block: int = 600):
     """(wall s, CPU s, epochs, satellites, observations) of the observables stage, blocks of ``block`` epochs,
     as the pipeline runs it (sky of the scenario's systems, trajectory truth at the GNSS rate)."""
+    from simkit.heap import keep_freed_memory
+
+    keep_freed_memory()  # as simkit.run does for its process
     sc = scenario(hours)
     t0, c0 = time.perf_counter(), time.process_time()
     sky = load_sky(sc.gnss.sources, sc.gnss.nav_systems)

@@ -1,5 +1,5 @@
 """Every array of the observables stage of ``bench_gnss.py`` from two checkouts, compared: the largest absolute
-difference per array (code, carrier, Doppler, range, range rate, ionosphere and its rate) and whether the NaN
+difference per array (observables, error terms, truth geometry and clocks, satellite states) and whether the NaN
 patterns agree. Each tree runs in its own interpreter with its ``simkit`` first on ``sys.path``.
 
     git worktree add /tmp/before <rev>; python benchmarks/gnss_ab.py /tmp/before . [--minutes 15]
@@ -27,17 +27,21 @@ from bench_gnss import scenario
 sc = scenario(float(sys.argv[4]) / 60.0)
 sim = GnssSimulator(sc.gnss, load_sky(sc.gnss.sources, sc.gnss.nav_systems), sc.start_week, sc.start_sow, sc.seed,
                     sc.duration_s)
+import dataclasses
 out = {}
+def keep(prefix, obj):
+    for f in dataclasses.fields(obj):
+        v = getattr(obj, f.name)
+        if isinstance(v, np.ndarray) and (f.name in ("sat_pos_ecef", "sat_clock") or v.ndim >= 2):
+            out.setdefault(prefix + f.name, []).append(np.asarray(v, dtype=float))
 for tr in Trajectory(sc.trajectory, sc.duration_s).blocks(rate_hz=sc.gnss.rate_hz, block_samples=300):
     ep = sim.process(tr.t, tr.pos_ecef, tr.vel_ecef(), tr.quat_nb, tr.omega_ib_b)
     for g, o in ep.obs.items():
-        for f in ("code", "carrier", "doppler"):
-            out.setdefault(f"{g}/{f}", []).append(getattr(o, f))
+        keep(f"{g}/", o)
     for g, o in ep.signal_truth.items():
-        for f in ("ionosphere", "ionosphere_rate"):
-            out.setdefault(f"{g}/{f}", []).append(getattr(o, f))
-    for f in ("range", "range_rate"):
-        out.setdefault(f, []).append(getattr(ep.truth, f))
+        keep(f"{g}/", o)
+    keep("truth/", ep.truth)
+    keep("", ep)
 np.savez(sys.argv[3], **{k: np.concatenate(v) for k, v in out.items()})
 """
 
@@ -60,7 +64,8 @@ def main() -> int:
         for key in a.files:
             x, y = a[key], b[key]
             same_nan &= bool(np.array_equal(np.isnan(x), np.isnan(y)))
-            print(f"{key:24s} max |A - B| {np.nanmax(np.abs(x - y)):.2e}")
+            diff = np.abs(x - y)
+            print(f"{key:32s} max |A - B| {np.nanmax(diff) if np.isfinite(diff).any() else 0.0:.2e}")
         print(f"NaN patterns {'identical' if same_nan else 'DIFFER'}")
     return 0
 

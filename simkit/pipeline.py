@@ -16,6 +16,7 @@ import numpy as np
 
 from . import gpstime
 from .errors import DataFileError, OutputError, ScenarioError
+from .heap import keep_freed_memory
 from .imu import ImuSimulator
 from .io.output import check_output
 from .io.writer import Writer, compression_threads
@@ -52,8 +53,10 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
     Everything that can be checked is checked before the first sample: the scenario, the constellation sources
     and their coverage of the run, the output path (an existing file is replaced only when it is a simkit file
     without /solutions), and the output size (refused above the free disk space or :data:`MAX_OUTPUT_BYTES`);
-    ``force`` overrides the last two.
+    ``force`` overrides the last two. The process keeps freed heap memory for the next block
+    (:func:`simkit.heap.keep_freed_memory`; glibc only, the user's ``MALLOC_*_`` tunables stand).
     """
+    keep_freed_memory()
     sc = load(scenario, assignments(overrides), seed=seed)
     out = Path(out) if out is not None else Path(f"{sc.name}.h5")
     sky = _sky(sc) if sc.gnss is not None else None

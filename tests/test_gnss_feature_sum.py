@@ -1,6 +1,7 @@
 """The clustered random-Fourier-feature sums behind the truth ionosphere against their closed form,
 sum_f cos(k_f . x + w_f t + phase_f) evaluated term by term with numpy."""
 import numpy as np
+import pytest
 
 from simkit.gnss.feature_sum import REDUCE_MAX, SMALL, feature_sums
 from simkit.gnss.iono_truth import TruthIonosphere
@@ -43,9 +44,13 @@ def test_far_members_and_huge_phases_take_the_exact_path():
     assert np.abs(got[:2] - want[:2]).max() < 1e-12 and np.abs(got[2:] - want[2:]).max() < 1e-8
 
 
-def test_truth_ionosphere_and_its_rate_equal_the_closed_form_field_at_every_antenna():
+@pytest.mark.parametrize("system, alpha, beta", [
+    ("G", (2.2352e-08, 1.4901e-08, -1.1921e-07, -5.9605e-08), (1.2493e05, 6.5536e04, -1.9661e05, 6.5536e04)),
+    ("C", (3.3528e-08, 6.7055e-08, -1.0133e-06, 1.6093e-06), (1.1878e05, 3.2768e04, 7.8643e05, -7.8643e05))])
+def test_truth_ionosphere_and_its_rate_equal_the_closed_form_field_at_every_antenna(system, alpha, beta):
     """The truth delay at three antennas 10 m apart and its central-difference rate, both from the closed-form
-    field at each antenna and time step: within 1e-9 m and 1e-9 m/s."""
+    field at each antenna and time step: within 1e-9 m and 1e-9 m/s; the Klobuchar delay (GPS or BDS model) within
+    1e-12 m of the array expression."""
     truth = TruthIonosphere(7, 0.5, 1000e3, 3600.0)
     rs = np.random.default_rng(2)
     m, c, h = 40, 12, 0.05
@@ -59,8 +64,7 @@ def test_truth_ionosphere_and_its_rate_equal_the_closed_form_field_at_every_ante
     el = np.broadcast_to(rs.uniform(0.2, 1.5, (m, 1, c)), (m, 3, c)) + rs.normal(0, 1e-6, (m, 3, c))
     az_rate, el_rate = rs.normal(0, 1e-4, (m, 3, c)), rs.normal(0, 1e-4, (m, 3, c))
     sow = (86400.0 + 30.0 * np.arange(m))[:, None, None]
-    alpha, beta = (2.2352e-08, 1.4901e-08, -1.1921e-07, -5.9605e-08), (1.2493e05, 6.5536e04, -1.9661e05, 6.5536e04)
-    iono, rate, klob = truth.delay("G", alpha, beta, lla, vel, az, el, az_rate, el_rate, np.full_like(sow, WEEK),
+    iono, rate, klob = truth.delay(system, alpha, beta, lla, vel, az, el, az_rate, el_rate, np.full_like(sow, WEEK),
                                    sow, sow - 86400.0)
 
     from simkit import earth
@@ -78,11 +82,12 @@ def test_truth_ionosphere_and_its_rate_equal_the_closed_form_field_at_every_ante
         r = SHELL_RADIUS_M + SHELL_HEIGHT_M
         x = np.stack([r * np.cos(lat_p) * np.cos(lon_p), r * np.cos(lat_p) * np.sin(lon_p), r * np.sin(lat_p)], -1)
         field = f.scale * np.cos(x @ f.k.T + (sow - 86400.0 + s)[..., None] * f.w + f.phase).sum(-1)
-        k = broadcast_ionosphere("G", alpha, beta, la, lo, a, e, sow + s)
-        return k * np.exp(truth.sigma * field - 0.5 * truth.sigma**2)
+        k = broadcast_ionosphere(system, alpha, beta, la, lo, a, e, sow + s)
+        return k * np.exp(truth.sigma * field - 0.5 * truth.sigma**2), k
 
-    want_rate = (exact(h) - exact(-h)) / (2 * h)
-    print(f"\nmax |delay - closed form| {np.abs(iono - exact(0.0)).max():.2e} m, rate "
+    want_rate = (exact(h)[0] - exact(-h)[0]) / (2 * h)
+    assert np.abs(klob - exact(0.0)[1]).max() < 1e-12
+    print(f"\nmax |delay - closed form| {np.abs(iono - exact(0.0)[0]).max():.2e} m, rate "
           f"{np.abs(rate - want_rate).max():.2e} m/s")
-    assert np.abs(iono - exact(0.0)).max() < 1e-9 and np.abs(rate - want_rate).max() < 1e-9
+    assert np.abs(iono - exact(0.0)[0]).max() < 1e-9 and np.abs(rate - want_rate).max() < 1e-9
     assert np.all(np.abs(iono / klob - 1.0) > 1e-6)   # the field does depart from Klobuchar

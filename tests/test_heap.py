@@ -1,4 +1,4 @@
-"""``simkit.heap.keep_freed_memory`` (the command line's process only): blocks of MB-sized arrays allocated and
+"""``simkit.heap.keep_freed_memory`` (called by ``simkit.run``): blocks of MB-sized arrays allocated and
 freed again and again stop faulting their pages in after the first round (glibc; elsewhere it reports False)."""
 import subprocess
 import sys

@@ -7,7 +7,6 @@ atomically, so a run is either complete on disk or absent, never half-written.
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import functools
 import os
 import socket
@@ -16,6 +15,7 @@ from pathlib import Path
 
 import numba
 
+from ..heap import keep_freed_memory
 from ..io import open_dataset
 from ..pipeline import run as simulate
 from .metrics import evaluate
@@ -23,10 +23,7 @@ from .plan import RunSpec
 from .records import RECORD_VERSION, file_digest, read_record, record_path, verify, write_json_atomic
 
 
-# glibc mallopt parameters (malloc.h)
-_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 TRIM_THRESHOLD_BYTES = 256 << 20
-MMAP_THRESHOLD_BYTES = 32 << 20  # glibc's largest dynamic mmap threshold on 64-bit systems
 
 
 @functools.cache
@@ -41,12 +38,7 @@ def tune_worker_process() -> bool:
       mmap threshold bring it back to 0.50 s. Memory stays bounded: a run writes in blocks, so its peak is what it
       is outside Dask. Other C libraries (musl, macOS) have no such setting and are left alone.
     """
-    try:
-        mallopt = ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):
-        return False
-    return bool(mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES)) and bool(mallopt(_M_MMAP_THRESHOLD,
-                                                                                  MMAP_THRESHOLD_BYTES))
+    return keep_freed_memory(TRIM_THRESHOLD_BYTES, override_env=True)  # the nanny's tunable is what this undoes
 
 
 @contextlib.contextmanager

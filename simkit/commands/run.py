@@ -20,10 +20,8 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..heap import keep_freed_memory
     from ..pipeline import run as simulate
 
-    keep_freed_memory()  # this process runs blocks of the same sizes: no page faults for each one again
     t0 = time.perf_counter()
     out = simulate(args.scenario, out=args.out, seed=args.seed, overrides=args.overrides, progress=not args.quiet,
                    force=args.force)

@@ -14,11 +14,13 @@ import numpy as np
 
 from .. import frames, gpstime
 from ..earth import C_LIGHT, OMEGA_E
+from .light_time import back_light_time, hermite_states, light_time_step, rotated_view
 from .model import Constellation
 
 LIGHT_TIME_ITERATIONS = 3  # each iteration shrinks the error by ~v_sat/c: 3 take 75 ms to < 1e-9 m
 REFINE_S = 1e-9  # a last light-time step above this (s) re-evaluates the broadcast state (see _emission)
 TAU_START_S = 0.075  # start of the iteration: about a MEO's light time (20,000 km)
+RECEPTION_GRID_S = 30  # s of GPS time between the broadcast states that start the iteration (interpolated)
 
 
 @dataclass
@@ -65,9 +67,14 @@ def sagnac_rotate(sat_pos: np.ndarray, receiver: np.ndarray) -> np.ndarray:
     return _rotate_z(sat_pos, OMEGA_E * tau)
 
 
-def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: bool = False) -> Geometry:
+def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: bool = False,
+                  reception_grid: bool = False) -> Geometry:
     """Emission times by light-time iteration with Earth rotation, for receivers at ``rx_pos`` (M, 3) m ECEF at
-    reception times (``gps_week`` scalar or (M,), ``gps_sow`` (M,) s GPS). Returns a :class:`Geometry`."""
+    reception times (``gps_week`` scalar or (M,), ``gps_sow`` (M,) s GPS). Returns a :class:`Geometry`.
+
+    ``reception_grid``: start the iteration from states interpolated on a 30 s grid of GPS time
+    (:func:`_reception_states`: for epochs a second apart, half the orbit evaluations); meant for dense epochs (a
+    receiver's run at 1 Hz or faster), not for sparse ones, where the grid would need more states than the epochs."""
     rx = np.atleast_2d(np.asarray(rx_pos, dtype=float))
     sow = np.atleast_1d(np.asarray(gps_sow, dtype=float))
     week = np.broadcast_to(np.asarray(gps_week), sow.shape)
@@ -75,21 +82,19 @@ def receiver_view(const: Constellation, rx_pos, gps_week, gps_sow, velocity: boo
     if rx.shape != (m, 3):
         rx = np.broadcast_to(rx, (m, 3))
     week_ms = np.broadcast_to(week[:, None], (m, s))
-    tau, tw, ts, out = _emission(const, rx, week_ms, sow, velocity)
-    pos = _rotate_z(out[0], OMEGA_E * tau)
-    diff = pos - rx[:, None, :]
-    rng = np.linalg.norm(diff, axis=-1)
-    los = diff / rng[..., None]
-    el, az = elevation_azimuth(rx, los)
+    tau, tw, ts, out = _emission(const, rx, week_ms, sow, velocity, reception_grid)
+    lla = frames.ecef_to_lla(rx)
+    pos, vel, rng, los, el, az = rotated_view(out[0], out[2] if velocity else None, rx, tau,
+                                              frames.ecef_to_enu_matrix(lla[:, 0], lla[:, 1]))
     return Geometry(
         tx_week=np.asarray(tw), tx_sow=np.where(np.isfinite(rng), ts, np.nan), sat_pos=pos,
-        sat_vel=_rotate_z(out[2], OMEGA_E * tau) if velocity else None, sat_clock=out[1],
+        sat_vel=vel, sat_clock=out[1],
         sat_drift=out[3] if velocity else None, range=rng, tau=rng / C_LIGHT, los=los, elevation=el, azimuth=az,
         sat_pos_emission=out[0],
     )
 
 
-def _emission(const, rx, week_ms, sow, velocity):
+def _emission(const, rx, week_ms, sow, velocity, reception_grid=False):
     """Light time tau (M, S) s, emission time (week, sow) and the satellite states there (``state_each``'s
     returns, with velocity and drift), for receivers ``rx`` (M, 3) at reception times.
 
@@ -99,17 +104,15 @@ def _emission(const, rx, week_ms, sow, velocity):
     d = tau' - tau along its own velocity and clock drift (|d| < 1e-11 s: the neglected acceleration term is
     below 1e-21 m). Entries whose step is still above :data:`REFINE_S` (no state at reception, near the
     end of a record's validity) are evaluated again at the new time, at most LIGHT_TIME_ITERATIONS times."""
-    now = const.state_each(week_ms, np.broadcast_to(sow[:, None], week_ms.shape), velocity=True)
-    tau = np.full(week_ms.shape, TAU_START_S)
-    for _ in range(LIGHT_TIME_ITERATIONS):
-        back = _rotate_z(now[0] - now[2] * tau[..., None], OMEGA_E * tau)
-        tau = np.linalg.norm(back - rx[:, None, :], axis=-1) / C_LIGHT
-        tau = np.where(np.isfinite(tau), tau, TAU_START_S)
+    if reception_grid:
+        now = _reception_states(const, week_ms, sow)
+    else:
+        now = const.state_each(week_ms, np.broadcast_to(sow[:, None], week_ms.shape), velocity=True)[::2]
+    tau = back_light_time(*now, rx, TAU_START_S, LIGHT_TIME_ITERATIONS)
     tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
     out = [np.array(x) for x in const.state_each(tw, ts, velocity=True)]
     for i in range(LIGHT_TIME_ITERATIONS + 1):
-        new = np.linalg.norm(_rotate_z(out[0], OMEGA_E * tau) - rx[:, None, :], axis=-1) / C_LIGHT
-        step = np.where(np.isfinite(new), new - tau, 0.0)
+        step = light_time_step(out[0], rx, tau)
         far = np.abs(step) > REFINE_S
         if i == LIGHT_TIME_ITERATIONS or not far.any():
             break
@@ -123,6 +126,25 @@ def _emission(const, rx, week_ms, sow, velocity):
     tau = tau + step
     tw, ts = gpstime.add_seconds(week_ms, sow[:, None], -tau)
     return tau, tw, ts, tuple(out) if velocity else (out[0], out[1])
+
+
+def _reception_states(const, week_ms, sow):
+    """Satellite positions and velocities (M, S, 3) at the reception times, which only start the light-time
+    iteration: cubic Hermite interpolation between broadcast states on a fixed grid of GPS time, every
+    :data:`RECEPTION_GRID_S` s (3e-7 m for a MEO, 3e-15 s of light time), evaluated only at the grid times that
+    bracket an epoch. The grid is absolute, so an epoch's states do not depend on the other epochs of the call
+    (files do not depend on the block split). A state wrong by more than c REFINE_S (a record changing between
+    grid times) costs only an extra evaluation in :func:`_emission`."""
+    per_week = int(gpstime.SECONDS_PER_WEEK) // RECEPTION_GRID_S
+    week = week_ms[:, 0].astype(np.int64)
+    node = week * per_week + np.floor(sow / RECEPTION_GRID_S).astype(np.int64)         # the grid time at or before
+    nodes = np.unique(np.concatenate([node, node + 1]))
+    n_week, n_sow = nodes // per_week, (nodes % per_week) * float(RECEPTION_GRID_S)
+    grid = const.state_each(np.broadcast_to(n_week[:, None], (nodes.size, week_ms.shape[1])),
+                            np.broadcast_to(n_sow[:, None], (nodes.size, week_ms.shape[1])), velocity=True)
+    k = np.searchsorted(nodes, node)
+    x = ((week - n_week[k]) * gpstime.SECONDS_PER_WEEK + (sow - n_sow[k])) / RECEPTION_GRID_S
+    return hermite_states(k, x, float(RECEPTION_GRID_S), grid[0], grid[2])
 
 
 def elevation_azimuth(rx_pos, los):

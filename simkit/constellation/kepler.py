@@ -24,6 +24,10 @@ COL = {name: k for k, name in enumerate(FIELDS)}
 GEO_TILT = -5.0 * math.pi / 180.0
 KEPLER_MAX_ITERATIONS = 30
 KEPLER_STOP = 1e-14  # Newton step (rad) that ends the iteration
+# calls with fewer states run on one thread: numba's thread team costs more CPU than it saves below this size, and
+# on a loaded machine wall time too (docs/benchmarks.md: a GNSS block of 600 epochs x 67 satellites, 40,200
+# states: 15.7 ms of CPU and 40 ms of wall on 2 threads against 9.6 ms and 23 ms on one)
+PARALLEL_MIN_STATES = 1 << 17
 KEPLER_TOL = 1e-13   # rad per unit |M| (RTKLIB's RTOL_KEPLER): a larger last step after 30 iterations is a failure
 # column numbers as module constants (numba compiles them in; a dict lookup cannot run inside the kernel)
 _TOE, _TOC, _SQRT_A, _E, _I0, _OMEGA0, _OMEGA, _M0, _DELTA_N, _IDOT, _OMEGA_DOT = (
@@ -108,29 +112,40 @@ def _geo_rotation(x, y, z, vx, vy, vz, om_e, tk, want_vel):
     return gx, gy, z1, c_t * vx + s_t * vy1 + om_e * gy, -s_t * vx + c_t * vy1 - om_e * gx, vz1
 
 
+@numba.njit(cache=True, inline="always")
+def _propagate_one(params, idx, t, want_vel, pos, clk, vel, drift, k):
+    if idx[k] < 0:  # no valid record
+        _store_nan(k, want_vel, pos, clk, vel, drift)
+        return
+    p = params[idx[k]]
+    tk = t[k] - p[_TOE]
+    a = p[_SQRT_A] * p[_SQRT_A]
+    n = math.sqrt(p[_MU] / (a * a * a)) + p[_DELTA_N]
+    ecc_anom, converged = _eccentric_anomaly(p[_M0] + n * tk, p[_E])
+    if not converged:
+        _store_nan(k, want_vel, pos, clk, vel, drift)
+        return
+    x, y, z, vx, vy, vz = _orbit(p, tk, n, ecc_anom, want_vel)
+    if p[_GEO] != 0.0:
+        x, y, z, vx, vy, vz = _geo_rotation(x, y, z, vx, vy, vz, p[_OMEGA_E], tk, want_vel)
+    dtc = t[k] - p[_TOC]
+    rel = p[_REL_F] * p[_E] * p[_SQRT_A]
+    clock = p[_AF0] + p[_AF1] * dtc + p[_AF2] * dtc * dtc + rel * math.sin(ecc_anom)
+    c_e = math.cos(ecc_anom)
+    rate = p[_AF1] + 2.0 * p[_AF2] * dtc + rel * c_e * (n / (1.0 - p[_E] * c_e))
+    _store(k, x, y, z, clock, vx, vy, vz, rate, want_vel, pos, clk, vel, drift)
+
+
 @numba.njit(cache=True, parallel=True)
 def _propagate(params, idx, t, want_vel, pos, clk, vel, drift):
     for k in numba.prange(idx.shape[0]):  # independent elements: results do not depend on the thread count
-        if idx[k] < 0:  # no valid record
-            _store_nan(k, want_vel, pos, clk, vel, drift)
-            continue
-        p = params[idx[k]]
-        tk = t[k] - p[_TOE]
-        a = p[_SQRT_A] * p[_SQRT_A]
-        n = math.sqrt(p[_MU] / (a * a * a)) + p[_DELTA_N]
-        ecc_anom, converged = _eccentric_anomaly(p[_M0] + n * tk, p[_E])
-        if not converged:
-            _store_nan(k, want_vel, pos, clk, vel, drift)
-            continue
-        x, y, z, vx, vy, vz = _orbit(p, tk, n, ecc_anom, want_vel)
-        if p[_GEO] != 0.0:
-            x, y, z, vx, vy, vz = _geo_rotation(x, y, z, vx, vy, vz, p[_OMEGA_E], tk, want_vel)
-        dtc = t[k] - p[_TOC]
-        rel = p[_REL_F] * p[_E] * p[_SQRT_A]
-        clock = p[_AF0] + p[_AF1] * dtc + p[_AF2] * dtc * dtc + rel * math.sin(ecc_anom)
-        c_e = math.cos(ecc_anom)
-        rate = p[_AF1] + 2.0 * p[_AF2] * dtc + rel * c_e * (n / (1.0 - p[_E] * c_e))
-        _store(k, x, y, z, clock, vx, vy, vz, rate, want_vel, pos, clk, vel, drift)
+        _propagate_one(params, idx, t, want_vel, pos, clk, vel, drift, k)
+
+
+@numba.njit(cache=True)
+def _propagate_serial(params, idx, t, want_vel, pos, clk, vel, drift):
+    for k in range(idx.shape[0]):
+        _propagate_one(params, idx, t, want_vel, pos, clk, vel, drift, k)
 
 
 @numba.njit(cache=True, inline="always")
@@ -162,5 +177,6 @@ def propagate(params: np.ndarray, idx: np.ndarray, t: np.ndarray, velocity: bool
     clk = np.empty(n)
     vel = np.empty((n, 3) if velocity else (0, 3))
     drift = np.empty(n if velocity else 0)
-    _propagate(np.ascontiguousarray(params), idx, t, velocity, pos, clk, vel, drift)
+    kernel = _propagate if n >= PARALLEL_MIN_STATES else _propagate_serial
+    kernel(np.ascontiguousarray(params), idx, t, velocity, pos, clk, vel, drift)
     return (pos, clk, vel, drift) if velocity else (pos, clk)

@@ -32,12 +32,14 @@ class Sky:
     def sources(self) -> list[str]:
         return [c.source for c in self.constellations]
 
-    def view(self, rx_pos, gps_week, gps_sow) -> dict[str, np.ndarray]:
+    def view(self, rx_pos, gps_week, gps_sow, reception_grid: bool = False) -> dict[str, np.ndarray]:
         """Light-time geometry for receivers at ``rx_pos`` (M, 3) m ECEF at reception (``gps_week``, ``gps_sow``
         (M,) s): ``sat_pos`` (M, S, 3) m at emission in the ECEF frame of reception, ``sat_pos_emission`` the same
         in the ECEF frame of emission, ``sat_vel`` (M, S, 3) m/s, ``sat_clock`` (M, S) s, ``sat_drift`` (M, S)
-        s/s, ``tau`` (M, S) s light time, ``elevation`` (M, S) rad (see :func:`receiver_view`)."""
-        parts = [receiver_view(c, rx_pos, gps_week, gps_sow, velocity=True) for c in self.constellations]
+        s/s, ``tau`` (M, S) s light time, ``elevation`` (M, S) rad (see :func:`receiver_view`, also for
+        ``reception_grid``)."""
+        parts = [receiver_view(c, rx_pos, gps_week, gps_sow, velocity=True, reception_grid=reception_grid)
+                 for c in self.constellations]
         return {k: np.concatenate([getattr(p, k) for p in parts], axis=1) for k in _VIEW_FIELDS}
 
     def klobuchar(self, system: str):

@@ -21,6 +21,7 @@ import numpy as np
 from .. import earth, rng
 from .atmosphere import broadcast_ionosphere, reference_frequency
 from .feature_sum import feature_sums
+from .iono_steps import klobuchar_and_pierce_points
 from .ionex import IONO_CONSTANT, TECU, IonexMaps, slant_factor
 
 SHELL_HEIGHT_M = 350e3            # thin-shell height of the random field's pierce points
@@ -96,6 +97,9 @@ class TruthIonosphere:
         lat_rate = vel_enu[..., 1, None] / (rm + hgt)
         lon_rate = vel_enu[..., 0, None] / ((rn + hgt) * np.cos(lat))
         steps = (-h, 0.0, h)
+        if self.field is not None and self.ionex is None:
+            return self._field_delay(system, alpha, beta, lat[..., 0], lon[..., 0], lat_rate[..., 0],
+                                     lon_rate[..., 0], az, el, az_rate, el_rate, sow, t, steps)
         klob, points = [], []
         for s in steps:
             la, lo, a, e = lat + s * lat_rate, lon + s * lon_rate, az + s * az_rate, el + s * el_rate
@@ -105,18 +109,22 @@ class TruthIonosphere:
                 lat_p, lon_p = pierce_point(la, lo, a, e, m.base_radius_m, m.height_m)
                 tec = m.vtec(week, sow + s, lat_p, lon_p) * slant_factor(e, m.base_radius_m, m.height_m)
                 points.append(IONO_CONSTANT * TECU * tec / reference_frequency(system) ** 2)
-            elif self.field is not None:
-                lat_p, lon_p = pierce_point(la, lo, a, e)
-                r = SHELL_RADIUS_M + SHELL_HEIGHT_M
-                points.append(np.stack([r * np.cos(lat_p) * np.cos(lon_p), r * np.cos(lat_p) * np.sin(lon_p),
-                                        r * np.sin(lat_p)], axis=-1))
-        if self.ionex is not None:
-            truth = points
-        elif self.field is not None:
-            shape = klob[1].shape
-            epoch_t = np.broadcast_to(np.asarray(t, dtype=float), shape)[:, 0, 0]
-            e = self.field.clusters(np.stack(points, axis=2), epoch_t, np.array(steps))       # (M, A, 3, C)
-            truth = [k * np.exp(self.sigma * e[:, :, j] - 0.5 * self.sigma**2) for j, k in enumerate(klob)]
-        else:
-            truth = klob
+        truth = points if self.ionex is not None else klob
         return truth[1], (truth[2] - truth[0]) / (2.0 * h), klob[1]
+
+    def _field_delay(self, system, alpha, beta, lat, lon, lat_rate, lon_rate, az, el, az_rate, el_rate, sow, t,
+                     steps):
+        """:meth:`delay` with the random field: Klobuchar and pierce points in one compiled pass
+        (:mod:`simkit.gnss.iono_steps`), receivers (M, A), lines of sight (M, A, C)."""
+        shape = np.broadcast_shapes(np.shape(az), np.shape(el))
+        az, el = np.broadcast_to(az, shape), np.broadcast_to(el, shape)
+        az_rate, el_rate = np.broadcast_to(az_rate, shape), np.broadcast_to(el_rate, shape)
+        lat, lon, lat_rate, lon_rate = (np.broadcast_to(x, shape[:2]) for x in (lat, lon, lat_rate, lon_rate))
+        epoch_sow = np.broadcast_to(np.asarray(sow, dtype=float), shape)[:, 0, 0]
+        epoch_t = np.broadcast_to(np.asarray(t, dtype=float), shape)[:, 0, 0]
+        klob, points = klobuchar_and_pierce_points(system, alpha, beta, lat, lon, lat_rate, lon_rate, az, el,
+                                                   az_rate, el_rate, epoch_sow, np.array(steps), SHELL_RADIUS_M,
+                                                   SHELL_HEIGHT_M)
+        e = self.field.clusters(points, epoch_t, np.array(steps))                          # (M, A, 3, C)
+        truth = klob * np.exp(self.sigma * e - 0.5 * self.sigma**2)
+        return truth[:, :, 1], (truth[:, :, 2] - truth[:, :, 0]) / (2.0 * steps[2]), klob[:, :, 1]

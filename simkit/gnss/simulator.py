@@ -26,6 +26,7 @@ import numpy as np
 
 from .. import frames, gpstime, rng
 from ..constellation import Sky, antenna_view, time_offsets
+from ..constellation.geometry import RECEPTION_GRID_S
 from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
 from ..errors import DataFileError, ScenarioError
@@ -34,10 +35,12 @@ from .acquisition import Acquisition
 from .clock import ClockProcess
 from .config import GnssConfig, check_sats, code_scale_at
 from .draws import KeyedNormals
-from .ephemeris_errors import EphemerisErrors, rac_axes
+from .ephemeris_errors import EphemerisErrors
 from .ionex import read_ionex
 from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
+from .columns import place_columns
+from .orbit_range import range_errors
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
 from .tropo_truth import TruthTroposphere
@@ -192,7 +195,7 @@ class GnssSimulator:
         week, sow = gpstime.add_seconds(self.start_week, self.start_sow, t)
         ant_pos, ant_vel, c_be = frames.lever_arm_ecef(pos, np.asarray(vel_ecef, dtype=float).reshape(t.size, 3),
                                                        quat_nb, omega_ib_b, self.lever)
-        ref = self.sky.view(pos, week, sow)
+        ref = self.sky.view(pos, week, sow, reception_grid=self.cfg.rate_hz * RECEPTION_GRID_S >= 2.0)
         low = self.cfg.elevation_mask_rad if self.env is None else min(self.cfg.elevation_mask_rad, 0.0)
         with np.errstate(invalid="ignore"):
             cand = np.flatnonzero((ref["elevation"] >= low - _MASK_MARGIN_RAD).any(axis=0))
@@ -285,6 +288,8 @@ class _Parts:
 
     def full(self, x, fill=np.nan):
         """(M, A, S) array with the candidate columns ``x`` and ``fill`` elsewhere."""
+        if np.asarray(x).dtype == np.float64:
+            return place_columns(x, self.cand, self.shape[2], fill=fill)
         out = np.full(self.shape, fill, dtype=np.asarray(x).dtype)
         out[..., self.cand] = x
         return out
@@ -330,19 +335,11 @@ class _Parts:
         pos, vel = np.nan_to_num(ref["sat_pos"][:, cand]), np.nan_to_num(ref["sat_vel"][:, cand])
         v_in = vel + np.cross(EARTH_RATE_ECEF, pos)
         rel = vel[:, None] - ant_vel[:, :, None]          # d(satellite - antenna)/dt in the rotating frame
-        diff = view.los * view.range[..., None]
         rac, rac_rate = e[:, cand, :3], e_rate[:, cand, :3]
-
-        def at(s):
-            with np.errstate(invalid="ignore"):
-                axes = rac_axes(pos + s * vel, v_in)                                     # (M, C, 3, 3)
-            d = np.einsum("mcki,mck->mci", axes, rac + s * rac_rate)
-            x = diff + s * rel
-            return np.linalg.norm(x + d[:, None], axis=-1) - np.linalg.norm(x, axis=-1)
-
         h = 0.5
-        self.orb = at(0.0)
-        self.orb_rate = (at(h) - at(-h)) / (2.0 * h)
+        orb = range_errors(view.los, view.range, rel, pos, vel, v_in, rac, rac_rate, np.array([0.0, h, -h]))
+        self.orb = orb[0]
+        self.orb_rate = (orb[1] - orb[2]) / (2.0 * h)
         self.range, self.range_rate = view.range + self.orb, view.range_rate + self.orb_rate
 
     def _troposphere(self, err):
@@ -426,9 +423,7 @@ class _Parts:
         keep = tracked[..., cols, j]
 
         def put(x, masked=False):
-            out = np.full(self.shape, np.nan)
-            out[..., cols] = np.where(keep, x, np.nan) if masked else x
-            return out
+            return place_columns(x, cols, self.shape[2], keep if masked else None)
 
         self.obs[g.name] = SignalObs(
             code=put(base + gd + iono + mp_c + n_c, True),
