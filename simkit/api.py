@@ -124,6 +124,11 @@ with tempfile.TemporaryDirectory() as tmp:
     for name, scenario in (("quickstart", "quickstart"), ("xian", xian)):
         path = simkit.run(scenario, out=f"{tmp}/{name}.h5")
         simkit.solve(path, list(registry()), on_each=lambda *a: None)
+# the parallel broadcast-orbit kernel of large calls (a day of `simkit sky` or `simkit validate`)
+import numpy as np
+from simkit.constellation import kepler
+n = kepler.PARALLEL_MIN_STATES
+kepler.propagate(kepler.empty_table(1), np.full(n, -1), np.zeros(n), velocity=True)
 """
 
 
