@@ -1,5 +1,6 @@
 """``simkit.heap.keep_freed_memory`` (called by ``simkit.run``): blocks of MB-sized arrays allocated and
 freed again and again stop faulting their pages in after the first round (glibc; elsewhere it reports False)."""
+import os
 import subprocess
 import sys
 
@@ -21,7 +22,9 @@ print(kept, resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0)
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt: Linux only")
 def test_freed_blocks_are_reused_without_page_faults():
     def faults(keep: str):
-        out = subprocess.run([sys.executable, "-c", CHILD, keep], capture_output=True, text=True, check=True)
+        # without glibc tunables in the environment (a Dask cluster started earlier in this process sets them)
+        env = {k: v for k, v in os.environ.items() if not k.startswith("MALLOC_")}
+        out = subprocess.run([sys.executable, "-c", CHILD, keep], env=env, capture_output=True, text=True, check=True)
         kept, count = out.stdout.split()
         return kept, int(count)
 
