@@ -26,9 +26,10 @@ def write_index(out: Path, rows: list[dict], records: dict | None = None) -> lis
     files = [out / r["file"] for r in done]
     layouts = [(records or {}).get(r["run_id"], {}).get("datasets") for r in done]
     if files and all(isinstance(lay, dict) for lay in layouts):
-        return write_campaign_index(out / "index.h5", index_columns(rows), files, list(layouts[0]), layouts)
-    paths = []
-    if files:
-        with open_dataset(files[0]) as ds:
-            paths = [p for p, _ in ds.datasets()]
-    return write_campaign_index(out / "index.h5", index_columns(rows), files, paths)
+        paths = list(layouts[0])
+    else:
+        layouts, paths = None, []
+        if files:
+            with open_dataset(files[0]) as ds:
+                paths = [p for p, _ in ds.datasets()]
+    return write_campaign_index(out / "index.h5", index_columns(rows), files, paths, layouts)
