@@ -157,8 +157,7 @@ def bias_walk(rate_random_walk: float, bias_instability: float) -> float:
 # errors (SISRE 0.5-1 m), ionosphere (half of Klobuchar's delay) and troposphere residuals through HDOP ~1, VDOP ~2.
 # Measured on simkit's realistic truth errors (xian_static_bds, 2 h, GPS+BDS: the 60 s mean of the SPP error has
 # RMS 0.9, 0.9, 1.9 m and decorrelates over 300-900 s) and in line with a broadcast SPP's 2-5 m (95 %).
-# Not by default in the H-infinity filter: its bound (theta I) acts on every state, and the part of the fixes' error
-# that no measurement separates from the position then grows (height errors of 13-82 m on the bundled scenarios).
+# (Not in the H-infinity filter's defaults: simkit.estimators.registry.)
 SPP_ERROR_SIGMA_M = (1.5, 1.5, 3.0)
 
 
@@ -183,7 +182,7 @@ def filter_config(ds, p, name) -> FilterConfig:
         update_at_start=p.get("align") == "truth",
         gnss_error_sigma=tuple(np.broadcast_to(np.asarray(
             p["gnss_error_sigma_m"] if p["gnss_error_sigma_m"] is not None
-            else (SPP_ERROR_SIGMA_M if p["gnss"] == "spp" and name != "hinf" else 0.0), float), 3)),
+            else (SPP_ERROR_SIGMA_M if p["gnss"] == "spp" else 0.0), float), 3)),
         gnss_error_tau=float(p["gnss_error_tau_s"]))
 
 
