@@ -47,7 +47,7 @@ class SppFixes:
     ionosphere: str = "none"
 
 
-def _geometry(r, sat):
+def ranges_and_lines_of_sight(r, sat):
     """Ranges with the Sagnac term (M, S) and unit line-of-sight vectors receiver->satellite (M, S, 3)."""
     d = sat - r[:, None, :]
     rho = np.linalg.norm(d, axis=-1)
@@ -143,7 +143,7 @@ def _iterate(code, sat, sys_onehot, mask_rad, sigma, iterations, delays, first, 
     for it in range(first, first + iterations):
         xa = x[active]
         with np.errstate(invalid="ignore", divide="ignore"):
-            rho, ea = _geometry(xa[:, :3], sat[active])
+            rho, ea = ranges_and_lines_of_sight(xa[:, :3], sat[active])
         ea = np.nan_to_num(ea)  # a satellite without a state (unhealthy) sits at the origin, as the receiver at first
         ela, az, lla = _elevation(xa[:, :3], ea)
         late = it >= 3

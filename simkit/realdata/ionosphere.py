@@ -48,7 +48,7 @@ def klobuchar_ratio(real: dict, reference, group_delay, iono: dict) -> dict:
     sys_of_sat = np.array([s[0] for s in real["sat_id"]])
     out = {}
     for system in ("G", "C"):
-        pair = _pair(signals, freq, system)
+        pair = dual_frequency_pair(signals, freq, system)
         if pair is None or system not in iono:
             continue
         i, j = pair
@@ -60,7 +60,7 @@ def klobuchar_ratio(real: dict, reference, group_delay, iono: dict) -> dict:
         lli = obs["lli"][signals[i]].astype(np.uint8) | obs["lli"][signals[j]].astype(np.uint8)
         valid = np.isfinite(p_gf) & np.isfinite(l_gf) & np.isfinite(el) & cols[None, :]
         label = fidelity.arcs(valid, lli, t, np.where(valid, l_gf, np.nan))
-        levelled = _level(l_gf, p_gf - l_gf, label)
+        levelled = level_to_carrier(l_gf, p_gf - l_gf, label)
         alpha, beta = iono[system]
         klob = atmosphere.broadcast_ionosphere(system, np.asarray(alpha), np.asarray(beta), lat, lon, az,
                                                np.where(np.isfinite(el), el, np.pi / 2), sow[:, None])
@@ -90,7 +90,7 @@ def residual_fraction(result: dict) -> float | None:
     return float(np.sqrt(np.sum(w * f ** 2) / np.sum(w)))
 
 
-def _pair(signals, freq, system):
+def dual_frequency_pair(signals, freq, system):
     """Indices (higher, lower frequency) of the system's first two signals on different frequencies."""
     idx = [k for k, s in enumerate(signals) if sigmod.get(s).system == system]
     for k in idx[1:]:
@@ -99,7 +99,7 @@ def _pair(signals, freq, system):
     return None
 
 
-def _level(l_gf, diff, label):
+def level_to_carrier(l_gf, diff, label):
     """``l_gf`` plus the mean of ``diff`` over each arc of ``label`` (NaN outside arcs)."""
     out = np.full(l_gf.shape, np.nan)
     ok = label >= 0

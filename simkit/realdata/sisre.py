@@ -54,16 +54,16 @@ from __future__ import annotations
 import numpy as np
 
 from .. import gpstime
-from ..earth import C_LIGHT, OMEGA_E
+from ..earth import C_LIGHT
 from ..gnss import atmosphere
 from ..gnss.tropo_truth import niell_mapping
 from ..gnss.truth_config import realistic_defaults
 from . import fidelity
-from .ionosphere import _level, _pair
+from ..gnss.spp import ranges_and_lines_of_sight
+from .ionosphere import dual_frequency_pair, level_to_carrier
 
 SYSTEMS = {"G": "gps", "C": "bds"}
 SISRE_WEIGHTS = {"G": (0.98, 1.0 / 49.0), "C": (0.98, 1.0 / 54.0)}   # (w_R, w_AC^2), Montenbruck et al. 2018
-INTERVAL_S = {"G": 7200.0, "C": 3600.0}    # a pass is cut where the system's ephemeris interval ends
 MIN_UNITS = 8
 MIN_EPOCHS = 3
 GEOSYNC_RADIUS_M = 40.0e6    # BDS GEO and IGSO orbit at 42,164 km, MEO at 27,906 km
@@ -92,7 +92,7 @@ def residuals(real: dict, reference, elevation_cut_deg: float = 10.0) -> dict:
     rx = np.broadcast_to(ref, (t.size, 3))
     el = fidelity.elevations(sat, ref)
     lat, lon, h = pymap3d.ecef2geodetic(*ref, deg=False)
-    rho = np.linalg.norm(sat - rx[:, None, :], axis=-1) + OMEGA_E * (sat[..., 0] * ref[1] - sat[..., 1] * ref[0]) / C_LIGHT
+    rho, los = ranges_and_lines_of_sight(rx, sat)    # with the Sagnac term
     gd = real["group_delay"] if real.get("group_delay") is not None else np.zeros((len(real["sat_id"]), len(signals)))
     system = np.array([s[0] for s in real["sat_id"]])
     y = np.full(el.shape, np.nan)
@@ -100,7 +100,7 @@ def residuals(real: dict, reference, elevation_cut_deg: float = 10.0) -> dict:
     pairs = {}
     obs = real["obs"]
     for letter in SYSTEMS:
-        pair = _pair(signals, freq, letter)
+        pair = dual_frequency_pair(signals, freq, letter)
         cols = system == letter
         if pair is None or not cols.any():
             continue
@@ -114,7 +114,7 @@ def residuals(real: dict, reference, elevation_cut_deg: float = 10.0) -> dict:
         with np.errstate(invalid="ignore"):
             ok = np.isfinite(p_if) & np.isfinite(el) & (el >= np.radians(elevation_cut_deg)) & cols[None, :]
         label = fidelity.arcs(ok & np.isfinite(l_if), lli, t)   # slips: the receiver's loss-of-lock flags, gaps
-        levelled = _level(l_if, p_if - l_if, label)
+        levelled = level_to_carrier(l_if, p_if - l_if, label)
         code = np.where(label >= 0, levelled, p_if)
         r = code - gd_if[None, :] + C_LIGHT * real["sat_clock"] - rho - atmosphere.troposphere(lat, h, el)
         y[ok] = r[ok]
@@ -123,8 +123,6 @@ def residuals(real: dict, reference, elevation_cut_deg: float = 10.0) -> dict:
     unit = _units(np.isfinite(y), t, real["start"], system)
     utc = gpstime.gps_to_utc(*real["start"])
     doy = utc.timetuple().tm_yday + (utc.hour * 3600 + utc.minute * 60 + utc.second) / 86400.0
-    with np.errstate(invalid="ignore"):
-        los = (sat - rx[:, None, :]) / np.linalg.norm(sat - rx[:, None, :], axis=-1, keepdims=True)
     return {"y": y, "noise_var": noise_var, "unit": unit, "el": el, "system": system, "lat": lat, "h": h, "los": los,
             "sat_pos": sat,
             "doy": doy, "pairs": pairs, "t": t, "sat_id": list(real["sat_id"])}
@@ -149,9 +147,8 @@ def _arc_mean_variance(mp, label, ok) -> np.ndarray:
     s2 = np.where(n > 1, ss / np.maximum(n - 1, 1), np.nan)
     pooled = float(np.sum(ss) / max(np.sum(n - 1), 1))
     s2 = np.where(np.isfinite(s2), s2, pooled)
-    d2 = dev.copy()
-    same = np.concatenate([inv[1:] == inv[:-1], [False]])
-    num = float(np.sum(d2[:-1][same[:-1]] * d2[1:][same[:-1]]))
+    same = inv[1:] == inv[:-1]          # consecutive values of one arc
+    num = float(np.sum(dev[:-1][same] * dev[1:][same]))
     rho = float(np.clip(num / np.sum(dev ** 2), 0.0, 0.95)) if np.sum(dev ** 2) > 0 else 0.0
     var = s2 / n * (1.0 + rho) / (1.0 - rho)
     flat = out.ravel(order="F")
@@ -163,10 +160,11 @@ def _arc_mean_variance(mp, label, ok) -> np.ndarray:
 
 def _units(valid, t, start, system) -> np.ndarray:
     """Pass labels (M, S) int (-1 where not valid): a new pass at a gap of more than 1.5 intervals or where the
-    satellite's ephemeris interval (:data:`INTERVAL_S` of GPS time) changes."""
+    satellite's ephemeris interval (the truth model's default ``*_ephemeris_interval_s`` of GPS time) changes."""
     week, sow = gpstime.add_seconds(*start, t)
     t_abs = np.asarray(week, float) * gpstime.SECONDS_PER_WEEK + np.asarray(sow, float)
-    period = np.array([INTERVAL_S.get(s, 7200.0) for s in system])
+    d = realistic_defaults()   # the truth model's ephemeris intervals (GPS 2 h, BDS 1 h uploads)
+    period = np.array([d.get(f"{SYSTEMS.get(s, 'gps')}_ephemeris_interval_s", 7200.0) for s in system])
     block = np.floor(t_abs[:, None] / period[None, :] + 0.5)     # the nearest-toe record, as the truth model
     m, s = valid.shape
     dt = np.diff(t)
@@ -179,14 +177,21 @@ def _units(valid, t, start, system) -> np.ndarray:
     return np.where(valid, label, -1)
 
 
+def _unit_systems(unit, system) -> np.ndarray:
+    """The system letter (U,) of each pass of ``unit`` (M, S) (-1: none), from the satellites' ``system`` (S,)."""
+    ok = unit >= 0
+    out = np.empty(int(unit.max()) + 1, dtype=system.dtype)
+    out[unit[ok]] = np.broadcast_to(system, unit.shape)[ok]
+    return out
+
+
 def _two_way(values, unit, system, iterations: int = 500, tol: float = 1e-9):
     """Per-unit coefficients (U,) of ``values`` (M, S) = c_sys(t) + b_u by least squares (alternating means),
     centred per system (mean over units 0)."""
     n_unit = int(unit.max()) + 1
     ok = unit >= 0
     b = np.zeros(n_unit)
-    unit_sys = np.empty(n_unit, dtype=system.dtype)
-    unit_sys[unit[ok]] = np.broadcast_to(system, unit.shape)[ok]
+    unit_sys = _unit_systems(unit, system)
     counts = np.bincount(unit[ok], minlength=n_unit)
     for _ in range(iterations):
         resid = np.where(ok, values - np.where(ok, b[np.maximum(unit, 0)], 0.0), np.nan)
@@ -231,7 +236,7 @@ def fit(res: dict, position: bool = True) -> dict | None:
     ok = unit >= 0
     noise = np.bincount(unit[ok], weights=res["noise_var"][ok], minlength=n_unit) / np.bincount(unit[ok])
     radius = np.linalg.norm(res["sat_pos"], axis=-1) if res.get("sat_pos") is not None else None
-    _, unit_sys0, _ = _two_way(np.where(ok, 0.0, np.nan), unit, system, iterations=1)
+    unit_sys0 = _unit_systems(unit, system)
     unit_class = unit_sys0.astype(object)
     if radius is not None:   # BDS geosynchronous passes (GEO, IGSO): their own SISRE class
         r_unit = np.bincount(unit[ok], weights=np.nan_to_num(radius[ok])) / np.bincount(unit[ok])
