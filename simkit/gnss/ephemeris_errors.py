@@ -61,21 +61,30 @@ class EphemerisErrors:
         """Errors (M, C, 4) m [radial, along, cross, clock] and their rates (M, C, 4) m/s at GPS times
         (``week``, ``sow``) (M,) for satellite columns ``cols`` (C,). The clock error is c (dT_true - dT_broadcast)."""
         t_abs = np.asarray(week, dtype=float) * SECONDS_PER_WEEK + np.asarray(sow, dtype=float)   # (M,)
-        out = np.zeros((t_abs.size, cols.size, 4))
+        cols = np.asarray(cols, dtype=np.int64)
+        # components first: elementwise passes over (M, L) with L satellites innermost, not over a length-4 axis
+        out = np.zeros((4, t_abs.size, cols.size))
         rate = np.zeros_like(out)
-        for c, s in enumerate(cols):
-            if not np.any(self.sigma[s] > 0):
-                continue
-            half = 0.5 * self.interval[s]
-            j = np.floor(t_abs / self.interval[s] + 0.5).astype(np.int64)
-            tau = (t_abs - j * self.interval[s]) / half
-            for jj in np.unique(j):
-                rows = j == jj
-                z0, z1, z2 = self._coefficients(s, int(jj))
-                tt = tau[rows, None]
-                out[rows, c] = z0 + z1 * tt + z2 * (tt**2 - 1.0 / 3.0)
-                rate[rows, c] = (z1 + 2.0 * z2 * tt) / half
-        # keep the cache small: intervals far behind the last epoch are never asked for again (epochs in order)
-        if len(self._coef) > 4 * len(self.sat_ids):
-            self._coef.clear()
+        live = np.flatnonzero(np.any(self.sigma[cols] > 0, axis=1))
+        if t_abs.size and live.size:
+            sats, interval = cols[live], self.interval[cols[live]]
+            half = 0.5 * interval
+            j = np.floor(t_abs[:, None] / interval + 0.5).astype(np.int64)               # (M, L) interval index
+            tau = (t_abs[:, None] - j * interval) / half
+            tau2 = tau**2 - 1.0 / 3.0
+            first = j.min(axis=0)
+            offset = j - first
+            # one pass per interval a satellite enters during the call (one or two for a block of a run)
+            for o in range(int(offset.max()) + 1):
+                z = np.stack([self._coefficients(int(s), int(f) + o) for s, f in zip(sats, first)], axis=-1)
+                e = z[0][:, None] + z[1][:, None] * tau + z[2][:, None] * tau2            # (4, M, L)
+                r = (z[1][:, None] + 2.0 * z[2][:, None] * tau) / half
+                here = None if not offset.any() else offset == o
+                out[:, :, live] = e if here is None else np.where(here, e, out[:, :, live])
+                rate[:, :, live] = r if here is None else np.where(here, r, rate[:, :, live])
+        out, rate = np.moveaxis(out, 0, -1), np.moveaxis(rate, 0, -1)
+        # keep the cache small: intervals behind the last epoch's are never asked for again (epochs in order)
+        if len(self._coef) > 4 * len(self.sat_ids) and t_abs.size:
+            last = np.floor(t_abs[-1] / self.interval + 0.5)
+            self._coef = {k: v for k, v in self._coef.items() if k[1] >= last[k[0]]}
         return out, rate

@@ -119,8 +119,9 @@ def _steps(bds, alpha, beta, lat, lon, lat_rate, lon_rate, az, el, az_rate, el_r
                                                           cos_el, tow + BDT_MINUS_GPST)
                     else:
                         klob[m, a, j, c] = _klobuchar_gps(alpha, beta, la, lo, sin_az, cos_az, el_s, tow)
-                    points[m, a, j, c, 0], points[m, a, j, c, 1], points[m, a, j, c, 2] = _pierce(
-                        la, sin_la, cos_la, sin_lo, cos_lo, sin_az, cos_az, sin_el, cos_el, shell_ratio, shell_r)
+                    if points.shape[0]:
+                        points[m, a, j, c, 0], points[m, a, j, c, 1], points[m, a, j, c, 2] = _pierce(
+                            la, sin_la, cos_la, sin_lo, cos_lo, sin_az, cos_az, sin_el, cos_el, shell_ratio, shell_r)
 
 
 def klobuchar_and_pierce_points(system: str, alpha, beta, lat, lon, lat_rate, lon_rate, az, el, az_rate, el_rate,
@@ -139,3 +140,18 @@ def klobuchar_and_pierce_points(system: str, alpha, beta, lat, lon, lat_rate, lo
     points = np.empty((m, a, f[11].size, c, 3))
     _steps(system == "C", *f, radius_m / (radius_m + height_m), radius_m + height_m, klob, points)
     return klob, points
+
+
+def klobuchar_delays(system: str, alpha, beta, lat, lon, az, el, sow) -> np.ndarray:
+    """Broadcast Klobuchar delays (M, A, C) m (system 'G': GPS model, L1; 'C': BDS model, B1I, BDT from GPS time)
+    of receivers at ``lat``/``lon`` (M, A) rad seeing satellites at ``az``/``el`` (M, A, C) rad at GPS seconds of
+    week ``sow`` (M,): :func:`klobuchar_and_pierce_points` at one time step, without the pierce points."""
+    if system not in ("G", "C"):
+        raise ValueError(f"system: {system!r} has no broadcast Klobuchar model; expected 'G' or 'C'")
+    f = [np.ascontiguousarray(x, dtype=float) for x in (alpha, beta, lat, lon, az, el, sow)]
+    m, a, c = f[4].shape
+    zero_ma, zero_mac = np.zeros((m, a)), np.zeros((m, a, c))
+    klob = np.empty((m, a, 1, c))
+    _steps(system == "C", f[0], f[1], f[2], f[3], zero_ma, zero_ma, f[4], f[5], zero_mac, zero_mac, f[6],
+           np.zeros(1), 1.0, 1.0, klob, np.empty((0, 0, 0, 0, 3)))
+    return klob[:, :, 0]

@@ -37,6 +37,7 @@ from .config import GnssConfig, check_sats, code_scale_at
 from .draws import KeyedNormals
 from .ephemeris_errors import EphemerisErrors
 from .ionex import read_ionex
+from .iono_steps import klobuchar_delays
 from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
 from .columns import place_columns
@@ -359,7 +360,15 @@ class _Parts:
 
     def _ionosphere(self, err):
         """Delay (M, A, C) m at each model's reference frequency (L1 for GPS, Galileo, QZSS, GLONASS; B1I for
-        BDS), its rate, and the truth minus the broadcast model."""
+        BDS), its rate, and the truth minus the broadcast model.
+
+        A truth that departs from the broadcast model is evaluated along the first antenna's lines of sight and
+        shared by every antenna of the vehicle: antennas metres apart see a satellite within a microradian of each
+        other, through pierce points metres apart on fields that vary over hundreds of kilometres (Klobuchar, the
+        truth's random field, a map's 2.5 deg cells), so their delays differ by tens of micrometres (at most
+        3.4e-5 m, near the horizon on B3I, on xian_static_bds's 9.4 m baseline: ``benchmarks/gnss_ab.py``), a
+        fiftieth of the carrier noise. The broadcast model, which a receiver evaluates at its own antenna, is taken
+        per antenna, so that truth minus the stored model error is exactly the receiver's correction."""
         self.iono = np.zeros(self.el.shape)
         self.iono_rate = np.zeros(self.el.shape)
         self.iono_error = np.zeros(self.el.shape)
@@ -367,21 +376,30 @@ class _Parts:
             return
         view, system, truth = self.view, self.sim.iono_model[self.cand], self.sim.truth_iono
         sow = self.sow[:, None, None]
+        first = slice(0, 1)
         for letter in "GC":
             cols = system == letter
             if not cols.any():
                 continue
             alpha, beta = self.sim.iono[letter]
-            args = (letter, alpha, beta, view.lla, view.vel_enu, self.az[..., cols], self.el[..., cols],
-                    view.azimuth_rate[..., cols], view.elevation_rate[..., cols])
             if truth is None:
-                self.iono[..., cols], self.iono_rate[..., cols] = atmosphere.ionosphere(*args, sow)
+                self.iono[..., cols], self.iono_rate[..., cols] = atmosphere.ionosphere(
+                    letter, alpha, beta, view.lla, view.vel_enu, self.az[..., cols], self.el[..., cols],
+                    view.azimuth_rate[..., cols], view.elevation_rate[..., cols], sow)
                 continue
-            iono, rate, klob = truth.delay(*args, self.week[:, None, None], sow, self.t[:, None, None])
-            seen = np.isfinite(view.range[..., cols])
+            iono, rate, klob = truth.delay(
+                letter, alpha, beta, view.lla[:, first], view.vel_enu[:, first], self.az[:, first][..., cols],
+                self.el[:, first][..., cols], view.azimuth_rate[:, first][..., cols],
+                view.elevation_rate[:, first][..., cols], self.week[:, None, None], sow, self.t[:, None, None])
+            seen = np.isfinite(view.range[:, first][..., cols])
             if not np.all(np.isfinite(iono)[seen]):
                 raise DataFileError(truth.ionex.path, "the TEC maps have no value at a pierce point of the run "
                                     "(a regional map, or missing values)")
+            if self.sim.n_ant > 1:
+                others = slice(1, None)
+                klob = np.concatenate([klob, klobuchar_delays(
+                    letter, alpha, beta, view.lla[:, others, 0], view.lla[:, others, 1],
+                    self.az[:, others][..., cols], self.el[:, others][..., cols], self.sow)], axis=1)
             self.iono[..., cols], self.iono_rate[..., cols] = iono, rate
             self.iono_error[..., cols] = iono - klob
 

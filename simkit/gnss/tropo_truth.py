@@ -13,6 +13,9 @@ Rates are central differences over +-``h`` s along the receiver's height and the
 """
 from __future__ import annotations
 
+import math
+
+import numba
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
@@ -35,24 +38,57 @@ _NMF_WET = np.array([[5.8021897e-4, 5.6794847e-4, 5.8118019e-4, 5.9727542e-4, 6.
 _NMF_HT = (2.53e-5, 5.49e-3, 1.14e-3)
 
 
-def _marini(el, a, b, c):
-    s = np.sin(el)
+def _marini(s, a, b, c):
+    """Marini's continued fraction in ``s`` = sin(el), normalised to 1 at the zenith (Niell's form)."""
     return (1.0 + a / (1.0 + b / (1.0 + c))) / (s + a / (s + b / (s + c)))
 
 
-def niell_mapping(lat, h, el, doy):
-    """Niell hydrostatic and wet mapping functions (m_h, m_w) at latitude ``lat`` rad, ellipsoidal height ``h`` m,
-    elevation ``el`` rad, day of year ``doy`` (UTC, fractional); broadcast together."""
+_marini_scalar = numba.njit(cache=True, inline="always", error_model="numpy")(_marini)
+
+
+def _niell_coefficients(lat, doy):
+    """Hydrostatic (a, b, c) and wet (a, b, c) of the Niell mapping at latitude ``lat`` rad and day of year
+    ``doy`` (broadcast together): two lists of three arrays."""
     alat = np.clip(np.abs(lat), _NMF_LAT[0], _NMF_LAT[-1])
     season = np.cos(2.0 * np.pi * ((doy - 28.0) / 365.25 + np.where(lat < 0.0, 0.5, 0.0)))
 
     def coef(table, i):
         return np.interp(alat, _NMF_LAT, table[i])
 
-    hyd = [coef(_NMF_HYD_AVG, i) - coef(_NMF_HYD_AMP, i) * season for i in range(3)]
-    m_h = _marini(el, *hyd) + (1.0 / np.sin(el) - _marini(el, *_NMF_HT)) * h / 1e3
-    m_w = _marini(el, *(coef(_NMF_WET, i) for i in range(3)))
+    return ([coef(_NMF_HYD_AVG, i) - coef(_NMF_HYD_AMP, i) * season for i in range(3)],
+            [coef(_NMF_WET, i) for i in range(3)])
+
+
+def niell_mapping(lat, h, el, doy):
+    """Niell hydrostatic and wet mapping functions (m_h, m_w) at latitude ``lat`` rad, ellipsoidal height ``h`` m,
+    elevation ``el`` rad, day of year ``doy`` (UTC, fractional); broadcast together."""
+    hyd, wet = _niell_coefficients(lat, doy)
+    s = np.sin(el)
+    m_h = _marini(s, *hyd) + (1.0 / s - _marini(s, *_NMF_HT)) * h / 1e3
+    m_w = _marini(s, *wet)
     return m_h, m_w
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _slants(niell, el, el_rate, steps, hyd, wet, height, zhd, zwd, model_zenith, out):
+    """Truth slant delays at the time steps and the receiver's model delay, per receiver r and line of sight c:
+    ``out[j]`` (J, R, C) at elevation el + steps[j] el_rate (steps[0] = 0: el itself), ``out[J]`` the model
+    (zenith / sin el)."""
+    ht_a, ht_b, ht_c = _NMF_HT
+    n_j = steps.size
+    for r in range(el.shape[0]):
+        for c in range(el.shape[1]):
+            s0 = math.sin(el[r, c])
+            for j in range(n_j):
+                s = s0 if j == 0 else math.sin(el[r, c] + steps[j] * el_rate[r, c])
+                if niell:
+                    m_h = (_marini_scalar(s, hyd[j, 0, r], hyd[j, 1, r], hyd[j, 2, r])
+                           + (1.0 / s - _marini_scalar(s, ht_a, ht_b, ht_c)) * height[j, r] / 1e3)
+                    m_w = _marini_scalar(s, wet[0, r], wet[1, r], wet[2, r])
+                else:
+                    m_h = m_w = 1.0 / s
+                out[j, r, c] = zhd[j, r] * m_h + zwd[j, r] * m_w
+            out[n_j, r, c] = model_zenith[r] / s0
 
 
 class TruthTroposphere:
@@ -85,9 +121,34 @@ class TruthTroposphere:
         return (zh + self.dzhd) * m_h + zwd * m_w
 
     def slant(self, lat, h, el, h_rate, el_rate, t, dt: float = 0.05):
-        """(truth, truth rate, model) m, m/s, m: the truth and its rate for a receiver climbing at ``h_rate`` m/s
-        and a satellite rising at ``el_rate`` rad/s, and the receiver's model delay."""
-        truth = self.delay(lat, h, el, t)
-        rate = (self.delay(lat, h + dt * h_rate, el + dt * el_rate, t + dt)
-                - self.delay(lat, h - dt * h_rate, el - dt * el_rate, t - dt)) / (2.0 * dt)
-        return truth, rate, troposphere(lat, h, el)
+        """(truth, truth rate, model) m, m/s, m: the truth and its rate for a receiver at latitude ``lat`` rad and
+        height ``h`` m climbing at ``h_rate`` m/s, a satellite at elevation ``el`` rad rising at ``el_rate``
+        rad/s, ``t`` s since the start (broadcast together), and the receiver's model delay
+        (:func:`simkit.gnss.atmosphere.troposphere`). The formulas of :meth:`delay` in one compiled pass over the
+        lines of sight; receiver terms are taken once per receiver when ``lat``, ``h``, ``h_rate`` and ``t`` are
+        constant along the last axis (receivers (M, A, 1), lines of sight (M, A, C))."""
+        shape = np.broadcast_shapes(*(np.shape(x) for x in (lat, h, el, h_rate, el_rate, t)))
+        full = shape or (1,)
+        try:
+            rows = full[:-1] + (1,)
+            lat, h, h_rate, t = (np.broadcast_to(x, rows).reshape(-1) for x in (lat, h, h_rate, t))
+            cols = full[-1]
+        except ValueError:  # receiver terms that vary along the last axis: one row per element
+            lat, h, h_rate, t = (np.broadcast_to(x, full).reshape(-1) for x in (lat, h, h_rate, t))
+            cols = 1
+        el, el_rate = (np.ascontiguousarray(np.broadcast_to(x, full), dtype=float).reshape(-1, cols)
+                       for x in (el, el_rate))
+        height = np.stack([h, h + dt * h_rate, h - dt * h_rate])                        # (J, R)
+        when = np.stack([t, t + dt, t - dt])                                            # (J, R)
+        zh, zw = saastamoinen_zenith(lat, height)
+        zwd = np.maximum(zw + self.dzwd + self.walk(when), 0.0)
+        hyd, wet = _niell_coefficients(lat, self.doy + when / 86400.0)
+        hyd = np.stack(np.broadcast_arrays(*hyd, height)[:3], axis=1)                   # (J, 3, R)
+        wet = np.stack([np.broadcast_to(w, lat.shape) for w in wet])                      # (3, R)
+        model = np.add(*saastamoinen_zenith(lat, h))
+        out = np.empty((4,) + el.shape)
+        _slants(self.mapping == "niell", el, el_rate, np.array([0.0, dt, -dt]), np.ascontiguousarray(hyd),
+                np.ascontiguousarray(wet), np.ascontiguousarray(height), np.ascontiguousarray(zh + self.dzhd),
+                np.ascontiguousarray(zwd), np.ascontiguousarray(model), out)
+        out = out.reshape((4,) + shape)
+        return out[0], (out[1] - out[2]) / (2.0 * dt), out[3]
