@@ -49,24 +49,35 @@ def _ratio(c, r):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _quantiles(u, out):
-    # the central formula everywhere first (a branch-free loop the compiler vectorises), then the tails
-    for i in range(u.size):
-        q = u[i] - 0.5
-        out[i] = q * _ratio(_CENTRAL, 0.180625 - q * q)
-    for i in range(u.size):
-        q = u[i] - 0.5
-        if abs(q) > 0.425:
-            r = math.sqrt(-math.log(u[i] if q < 0.0 else 1.0 - u[i]))
-            x = _ratio(_NEAR_TAIL, r - 1.6) if r <= 5.0 else _ratio(_FAR_TAIL, r - 5.0)
-            out[i] = -x if q < 0.0 else x
+def _quantiles(u, shift, out):
+    """Normal quantiles of ``u`` (N,) + ``shift`` into ``out`` (any layout, N elements in C order)."""
+    n_g, n_k = out.shape[1], out.shape[2]
+    # the central formula everywhere first (branch-free), then the tails
+    i = 0
+    for m in range(out.shape[0]):
+        for g in range(n_g):
+            for k in range(n_k):
+                q = (u[i] + shift) - 0.5
+                out[m, g, k] = q * _ratio(_CENTRAL, 0.180625 - q * q)
+                i += 1
+    i = 0
+    for m in range(out.shape[0]):
+        for g in range(n_g):
+            for k in range(n_k):
+                p = u[i] + shift
+                i += 1
+                q = p - 0.5
+                if abs(q) > 0.425:
+                    r = math.sqrt(-math.log(p if q < 0.0 else 1.0 - p))
+                    x = _ratio(_NEAR_TAIL, r - 1.6) if r <= 5.0 else _ratio(_FAR_TAIL, r - 5.0)
+                    out[m, g, k] = -x if q < 0.0 else x
 
 
 def normal_quantiles(u) -> np.ndarray:
     """Standard normal quantiles of probabilities ``u`` in (0, 1) (any shape; AS 241: relative error ~1e-16)."""
     u = np.ascontiguousarray(u, dtype=float)
     out = np.empty_like(u)
-    _quantiles(u.reshape(-1), out.reshape(-1))
+    _quantiles(u.reshape(-1), 0.0, out.reshape(-1, 1, 1))
     return out
 
 
@@ -84,16 +95,22 @@ class KeyedNormals:
         satellite does not transmit."""
         n_ant = len(self.streams)
         out = np.zeros((m, n_ant, cols.size, self.n_signals, DRAWS_PER_SIGNAL))
+        buf = np.empty(m * self.n_signals * DRAWS_PER_SIGNAL)
         for c, s in enumerate(cols):
             sigs = self.signals_of_sat[s]
-            per_epoch = sigs.size * DRAWS_PER_SIGNAL
+            if sigs.size and sigs[-1] - sigs[0] + 1 == sigs.size:   # consecutive signals: write through a view
+                sigs = slice(int(sigs[0]), int(sigs[-1]) + 1)
+            per_epoch = (out[0, 0, 0, sigs, 0].size) * DRAWS_PER_SIGNAL
             for a in range(n_ant):
                 gen = self.streams[a][s]
                 skip = k0 * per_epoch - self.position[a, s]
                 if skip < 0:
                     raise ValueError(f"epochs must be drawn in order (epoch {k0} after {self.position[a, s]})")
                 gen.bit_generator.advance(int(skip))
-                u = gen.random(m * per_epoch) + _HALF_ULP
-                out[:, a, c, sigs] = normal_quantiles(u).reshape(m, sigs.size, DRAWS_PER_SIGNAL)
+                u = gen.random(out=buf[:m * per_epoch])
+                if isinstance(sigs, slice):
+                    _quantiles(u, _HALF_ULP, out[:, a, c, sigs])
+                else:
+                    out[:, a, c, sigs] = normal_quantiles(u + _HALF_ULP).reshape(m, sigs.size, DRAWS_PER_SIGNAL)
                 self.position[a, s] = (k0 + m) * per_epoch
         return out

@@ -16,6 +16,9 @@ position, C along r x v (inertial velocity), A = C x R.
 """
 from __future__ import annotations
 
+import math
+
+import numba
 import numpy as np
 
 from .. import rng
@@ -32,6 +35,21 @@ def rac_axes(pos, vel_inertial):
     c = np.cross(pos, vel_inertial)
     c /= np.linalg.norm(c, axis=-1, keepdims=True)
     return np.stack([r, np.cross(c, r), c], axis=-2)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _evaluate(t_abs, live, interval, first, coef, out, rate):
+    """e(tau) and de/dt into ``out``/``rate`` (M, C, 4) at columns ``live`` (L,), intervals ``interval`` (L,) s,
+    coefficient rows (z0, z1, z2) ``coef`` (L, J, 3, 4) of the intervals ``first`` (L,) + 0 .. J - 1."""
+    for m in range(t_abs.size):
+        for i in range(live.size):
+            j = math.floor(t_abs[m] / interval[i] + 0.5)
+            half = 0.5 * interval[i]
+            tau = (t_abs[m] - j * interval[i]) / half
+            z = coef[i, np.int64(j) - first[i]]
+            for k in range(4):
+                out[m, live[i], k] = z[0, k] + z[1, k] * tau + z[2, k] * (tau**2 - 1.0 / 3.0)
+                rate[m, live[i], k] = (z[1, k] + 2.0 * z[2, k] * tau) / half
 
 
 class EphemerisErrors:
@@ -62,27 +80,20 @@ class EphemerisErrors:
         (``week``, ``sow``) (M,) for satellite columns ``cols`` (C,). The clock error is c (dT_true - dT_broadcast)."""
         t_abs = np.asarray(week, dtype=float) * SECONDS_PER_WEEK + np.asarray(sow, dtype=float)   # (M,)
         cols = np.asarray(cols, dtype=np.int64)
-        # components first: elementwise passes over (M, L) with L satellites innermost, not over a length-4 axis
-        out = np.zeros((4, t_abs.size, cols.size))
+        out = np.zeros((t_abs.size, cols.size, 4))
         rate = np.zeros_like(out)
         live = np.flatnonzero(np.any(self.sigma[cols] > 0, axis=1))
         if t_abs.size and live.size:
-            sats, interval = cols[live], self.interval[cols[live]]
-            half = 0.5 * interval
-            j = np.floor(t_abs[:, None] / interval + 0.5).astype(np.int64)               # (M, L) interval index
-            tau = (t_abs[:, None] - j * interval) / half
-            tau2 = tau**2 - 1.0 / 3.0
-            first = j.min(axis=0)
-            offset = j - first
-            # one pass per interval a satellite enters during the call (one or two for a block of a run)
-            for o in range(int(offset.max()) + 1):
-                z = np.stack([self._coefficients(int(s), int(f) + o) for s, f in zip(sats, first)], axis=-1)
-                e = z[0][:, None] + z[1][:, None] * tau + z[2][:, None] * tau2            # (4, M, L)
-                r = (z[1][:, None] + 2.0 * z[2][:, None] * tau) / half
-                here = None if not offset.any() else offset == o
-                out[:, :, live] = e if here is None else np.where(here, e, out[:, :, live])
-                rate[:, :, live] = r if here is None else np.where(here, r, rate[:, :, live])
-        out, rate = np.moveaxis(out, 0, -1), np.moveaxis(rate, 0, -1)
+            interval = self.interval[cols[live]]
+            first = np.floor(t_abs.min() / interval + 0.5).astype(np.int64)
+            last = np.floor(t_abs.max() / interval + 0.5).astype(np.int64)
+            # the coefficients of every interval a satellite enters during the call (one or two for a run's block)
+            span = int((last - first).max()) + 1
+            coef = np.zeros((live.size, span, 3, 4))
+            for i, s in enumerate(cols[live]):
+                for o in range(int(last[i] - first[i]) + 1):
+                    coef[i, o] = self._coefficients(int(s), int(first[i]) + o)
+            _evaluate(np.ascontiguousarray(t_abs), live, interval, first, coef, out, rate)
         # keep the cache small: intervals behind the last epoch's are never asked for again (epochs in order)
         if len(self._coef) > 4 * len(self.sat_ids) and t_abs.size:
             last = np.floor(t_abs[-1] / self.interval + 0.5)

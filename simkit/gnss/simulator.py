@@ -408,6 +408,8 @@ class _Parts:
         sim, cfg, err = self.sim, self.sim.cfg, self.sim.cfg.errors
         cj = np.flatnonzero(sim.carries[self.cand, j])
         cols = self.cand[cj]
+        if cj.size and cj[-1] - cj[0] + 1 == cj.size:  # one system's columns, consecutive: views, not copies
+            cj = slice(int(cj[0]), int(cj[-1]) + 1)
         rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
         cn0_off = g.cn0_offset_db + cfg.cn0_offset_db.get(g.name, 0.0)
         cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, cn0_off)
