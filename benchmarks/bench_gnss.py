@@ -43,9 +43,10 @@ def scenario(hours: float):
                                     f"gnss.signals={SIGNALS!r}"])
 
 
-def ours(hours: float, block: int = 600):
+def ours(hours: float, block: int = 600, ahead: bool = True):
     """(wall s, CPU s, epochs, satellites, observations) of the observables stage, blocks of ``block`` epochs,
-    as the pipeline runs it (sky of the scenario's systems, trajectory truth at the GNSS rate)."""
+    as the pipeline runs it (sky of the scenario's systems, trajectory truth at the GNSS rate; ``ahead``: the
+    next block's geometry on a second thread, ``GnssSimulator.process_blocks``)."""
     from simkit.heap import keep_freed_memory
 
     keep_freed_memory()  # as simkit.run does for its process
@@ -54,11 +55,12 @@ def ours(hours: float, block: int = 600):
     sky = load_sky(sc.gnss.sources, sc.gnss.nav_systems)
     sim = GnssSimulator(sc.gnss, sky, sc.start_week, sc.start_sow, sc.seed, sc.duration_s)
     n_obs = m = 0
-    for truth in Trajectory(sc.trajectory, sc.duration_s).blocks(rate_hz=sc.gnss.rate_hz, block_samples=block):
-        out = sim.process(truth.t, truth.pos_ecef, truth.vel_ecef(), truth.quat_nb, truth.omega_ib_b)
+    blocks = ((tr.t, tr.pos_ecef, tr.vel_ecef(), tr.quat_nb, tr.omega_ib_b)
+              for tr in Trajectory(sc.trajectory, sc.duration_s).blocks(rate_hz=sc.gnss.rate_hz, block_samples=block))
+    for out in sim.process_blocks(blocks, ahead=ahead):
         for sig in sc.gnss.signals:
             n_obs += int(np.isfinite(out.obs[sig].carrier).sum())
-        m += truth.t.size
+        m += out.t.size
         del out
     return time.perf_counter() - t0, time.process_time() - c0, m, len(sim.sat_ids), n_obs
 

@@ -248,38 +248,53 @@ def _truth_ahead(blocks: Iterator, ahead: bool) -> Iterator:
 
 
 def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress: bool, ahead: bool = False) -> None:
+    """Every block of the run into ``w``: truth and IMU rows per truth block, then the GNSS epochs of each block
+    (``ahead``: the truth and the next GNSS slice's geometry on worker threads)."""
     _write_static(w, sc, stages)
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=stages.trajectory.n_samples(), unit="sample", unit_scale=True, desc=sc.name, leave=False)
-    stride = int(round(sc.trajectory.rate_hz / sc.gnss.rate_hz)) if stages.gnss is not None else 0
-    k = 0
     try:
-        for truth in _truth_ahead(stages.trajectory.blocks(block_samples=block_samples), ahead):
-            rows = _rows("truth", truth)
-            if stages.imu is not None:
-                rows.update(_imu_rows(truth.t, stages.imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)))
-            for path, data in rows.items():
-                w.append(path, data, handed_over=True)  # fresh arrays of this block, never written to again
-            if stages.gnss is not None:
-                _write_gnss(w, stages.gnss, truth, np.nonzero((np.arange(k, k + len(truth.t)) % stride) == 0)[0])
-            k += len(truth.t)
-            if bar is not None:
-                bar.update(len(truth.t))
+        blocks = _truth_rows(w, stages, _truth_ahead(stages.trajectory.blocks(block_samples=block_samples), ahead),
+                             bar)
+        if stages.gnss is None:
+            for _ in blocks:
+                pass
+            return
+        for ep in stages.gnss.process_blocks(_gnss_slices(sc, stages.gnss, blocks), ahead=ahead):
+            for path, data in gnss_rows(ep).items():
+                w.append(path, data)
     finally:
         if bar is not None:
             bar.close()
 
 
-def _write_gnss(w: Writer, gnss: GnssSimulator, truth, idx: np.ndarray) -> None:
-    """GNSS epochs ``idx`` of a truth block, in slices of at most :data:`GNSS_CELLS` (epoch, antenna, satellite,
-    signal) cells, so memory stays bounded when the GNSS rate approaches the truth rate."""
+def _truth_rows(w: Writer, stages: Stages, blocks: Iterator, bar) -> Iterator:
+    """The truth blocks, each written (truth and IMU rows) before it is handed on."""
+    for truth in blocks:
+        rows = _rows("truth", truth)
+        if stages.imu is not None:
+            rows.update(_imu_rows(truth.t, stages.imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)))
+        for path, data in rows.items():
+            w.append(path, data, handed_over=True)  # fresh arrays of this block, never written to again
+        yield truth
+        if bar is not None:
+            bar.update(len(truth.t))
+
+
+def _gnss_slices(sc: Scenario, gnss: GnssSimulator, blocks: Iterator) -> Iterator[tuple]:
+    """The GNSS epochs of the truth blocks (every ``rate_hz / gnss.rate_hz``-th sample) as the arguments of
+    :meth:`GnssSimulator.process`, in slices of at most :data:`GNSS_CELLS` (epoch, antenna, satellite, signal)
+    cells, so memory stays bounded when the GNSS rate approaches the truth rate."""
+    stride = int(round(sc.trajectory.rate_hz / sc.gnss.rate_hz))
     per_epoch = gnss.n_ant * len(gnss.sat_ids) * len(gnss.signals)
     step = max(1, GNSS_CELLS // max(1, per_epoch))
-    for start in range(0, idx.size, step):
-        sub = truth.take(idx[start:start + step])
-        for path, data in gnss_rows(gnss.process(sub.t, sub.pos_ecef, sub.vel_ecef(), sub.quat_nb,
-                                                 sub.omega_ib_b)).items():
-            w.append(path, data)
+    k = 0
+    for truth in blocks:
+        idx = np.nonzero((np.arange(k, k + len(truth.t)) % stride) == 0)[0]
+        k += len(truth.t)
+        for start in range(0, idx.size, step):
+            sub = truth.take(idx[start:start + step])
+            yield sub.t, sub.pos_ecef, sub.vel_ecef(), sub.quat_nb, sub.omega_ib_b

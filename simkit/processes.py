@@ -30,7 +30,7 @@ def ar1_coefficients(sigma: float, tau_s: float, dt_s: float) -> tuple[float, fl
     return math.exp(-dt_s / tau_s), sigma * math.sqrt(-math.expm1(-2.0 * dt_s / tau_s))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _ar1_kernel(w, restart, phi, drive, sigma, state, out):  # pragma: no cover - compiled
     """out[k, i] = sigma w[k, i] where restart[k, i], else phi out[k-1, i] + drive w[k, i]; state[i] carries
     out[-1, i] between calls. ``restart`` of shape (0, 0) means "never restart"."""

@@ -157,6 +157,16 @@ def test_block_split_gives_identical_arrays_and_seed_determinism():
         np.testing.assert_array_equal(a[k], b[k], err_msg=k)
     c = run(make(extra, seed=4))
     assert not np.array_equal(a["obs/L1C/code"], c["obs/L1C/code"], equal_nan=True)
+    # the blocks' geometry computed a block ahead on a worker thread (what simkit.run does): the same arrays
+    sim = make(extra)
+    t = sim.epoch_times()
+    truth = static_truth(t)
+    parts = list(sim.process_blocks((t[i], *(x[i] for x in truth))
+                                    for i in np.array_split(np.arange(t.size), 7)))
+    assert len(parts) == 7
+    rows = [gnss_rows(p, prefix="") for p in parts]
+    for k in a:
+        np.testing.assert_array_equal(a[k], np.concatenate([r[k] for r in rows]), err_msg=k)
 
 
 def test_slips_outages_and_lli():

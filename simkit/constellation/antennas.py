@@ -69,7 +69,7 @@ def antenna_view(ref: dict, ant_pos: np.ndarray, ant_vel: np.ndarray) -> Antenna
 EXTRA_LIGHT_TIME_ITERATIONS = 2  # light time to each antenna minus the reference one: each gains a factor v/c
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _per_satellite(x0, sat_vel, tau0, clock0, drift0, ant_pos, ant_vel, c_en, w_en, iterations,
                    rng, rr, el, az, el_rate, az_rate, clock, los):
     om = OMEGA_E

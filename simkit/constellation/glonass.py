@@ -55,7 +55,7 @@ def _derivative(x, acc, out):
     out[5] = (common - 2.0 * j2_term) * x[2] + acc[2]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _rk4_step(x, acc, h, k1, k2, k3, k4, w):
     _derivative(x, acc, k1)
     for i in range(6):
@@ -71,7 +71,7 @@ def _rk4_step(x, acc, h, k1, k2, k3, k4, w):
         x[i] += h * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, nogil=True, parallel=True)
 def _integrate(params, idx, t, out):
     """out[k] = (x, y, z, vx, vy, vz, clock, drift) of record params[idx[k]] at time t[k]; NaN where idx < 0."""
     for k in numba.prange(idx.shape[0]):  # independent elements: results do not depend on the thread count

@@ -136,13 +136,13 @@ def _propagate_one(params, idx, t, want_vel, pos, clk, vel, drift, k):
     _store(k, x, y, z, clock, vx, vy, vz, rate, want_vel, pos, clk, vel, drift)
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, nogil=True, parallel=True)
 def _propagate(params, idx, t, want_vel, pos, clk, vel, drift):
     for k in numba.prange(idx.shape[0]):  # independent elements: results do not depend on the thread count
         _propagate_one(params, idx, t, want_vel, pos, clk, vel, drift, k)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _propagate_serial(params, idx, t, want_vel, pos, clk, vel, drift):
     for k in range(idx.shape[0]):
         _propagate_one(params, idx, t, want_vel, pos, clk, vel, drift, k)

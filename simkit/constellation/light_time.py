@@ -22,7 +22,7 @@ def _rotated(x, y, angle):
     return c * x + s * y, -s * x + c * y
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _back_iterate(pos, vel, rx, tau_start, iterations, tau):
     for m in range(pos.shape[0]):
         for s in range(pos.shape[1]):
@@ -36,7 +36,7 @@ def _back_iterate(pos, vel, rx, tau_start, iterations, tau):
             tau[m, s] = t
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _step(pos, rx, tau, step):
     for m in range(pos.shape[0]):
         for s in range(pos.shape[1]):
@@ -46,7 +46,7 @@ def _step(pos, rx, tau, step):
             step[m, s] = new - tau[m, s] if math.isfinite(new) else 0.0
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _view(pos_e, vel_e, rx, c_en, tau, pos, vel, rng, los, el, az):
     for m in range(pos_e.shape[0]):
         c = c_en[m]
@@ -100,7 +100,7 @@ def rotated_view(pos_e, vel_e, rx, tau, c_en):
     return pos, (vel if vel.shape[0] else None), rng, los, el, az
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _hermite(k, x, h, pos_g, vel_g, pos, vel):
     for m in range(k.shape[0]):
         xm = x[m]

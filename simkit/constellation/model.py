@@ -312,7 +312,7 @@ class KeplerConstellation(Constellation):
         return kepler.propagate(self.records.params, idx.ravel(), t_eval.ravel(), velocity)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _select(rows, toe, half, bounds, after, t, idx):
     """Record index per (time, satellite) (see :meth:`KeplerConstellation.select`): satellite s's healthy records
     are ``rows[bounds[s]:bounds[s + 1]]`` sorted by ``toe``, valid ``half`` s either side (``after[s]``: only after,

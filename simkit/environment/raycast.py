@@ -25,7 +25,7 @@ _EPS_T = 1e-9      # m: a ray does not hit the wall it starts on
 _INF = np.inf
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _hits(ox, oy, oz, dx, dy, tan_el, t_max, exclude, w0, w1, ax, ay, bx, by, top, cell_walls):
     """Whether the ray hits one of the walls cell_walls[w0:w1] within horizontal distance t_max."""
     for k in range(w0, w1):
@@ -48,7 +48,7 @@ def _hits(ox, oy, oz, dx, dy, tan_el, t_max, exclude, w0, w1, ax, ay, bx, by, to
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def blocked(ox, oy, oz, dx, dy, tan_el, t_max, exclude, x0, y0, cell, nx, ny, start, cell_walls,
             ax, ay, bx, by, top, z_top):
     """Whether a ray from (ox, oy, oz) with horizontal unit direction (dx, dy) and slope ``tan_el`` meets a wall
@@ -105,7 +105,7 @@ def blocked(ox, oy, oz, dx, dy, tan_el, t_max, exclude, x0, y0, cell, nx, ny, st
             return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _near_walls(px, py, range_m, x0, y0, cell, nx, ny, start, cell_walls, stamp, mark, near):
     """Fill ``near`` with the walls in the cells within ``range_m`` of (px, py) (each once, using ``stamp``
     marked with ``mark``); returns their number."""
@@ -126,7 +126,7 @@ def _near_walls(px, py, range_m, x0, y0, cell, nx, ny, start, cell_walls, stamp,
     return n_near
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _best_reflection(px, py, pz, sa, ca, ce, se, near, n_near, range_m, x0, y0, cell, nx, ny, start,
                      cell_walls, ax, ay, bx, by, top, z_top):
     """The wall (-1 for none) and extra path (m) of the shortest valid reflection among the walls ``near``."""
@@ -164,7 +164,7 @@ def _best_reflection(px, py, pz, sa, ca, ce, se, near, n_near, range_m, x0, y0, 
     return best_w, best
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, nogil=True, parallel=True)
 def trace(pos, az, el, x0, y0, cell, nx, ny, start, cell_walls, ax, ay, bx, by, top, range_m, reflections):
     """Direct blocking and the best reflection for antennas at ``pos`` (M, A, 3) m and satellites at ``az``,
     ``el`` (M, A, C) rad. Returns ``direct_blocked`` (M, A, C) bool, ``wall`` (M, A, C) int64 (the reflecting

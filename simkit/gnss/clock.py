@@ -74,7 +74,7 @@ class ClockProcess:
         return bias, drift
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _propagate(b, d, dt, w):
     """x_{k+1} = [[1, dt], [0, 1]] x_k + w_k, one step per row of ``w``, sequentially (bit-identical for any
     split of the epochs into blocks)."""

@@ -7,7 +7,7 @@ import numba
 import numpy as np
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _place(x, cols, keep, masked, fill, out):
     for m in range(out.shape[0]):
         for a in range(out.shape[1]):

@@ -48,7 +48,7 @@ def _ratio(c, r):
     return num / den
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _quantiles(u, shift, out):
     """Normal quantiles of ``u`` (N,) + ``shift`` into ``out`` (any layout, N elements in C order)."""
     n_g, n_k = out.shape[1], out.shape[2]

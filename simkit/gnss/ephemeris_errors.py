@@ -37,7 +37,7 @@ def rac_axes(pos, vel_inertial):
     return np.stack([r, np.cross(c, r), c], axis=-2)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _evaluate(t_abs, live, interval, first, coef, out, rate):
     """e(tau) and de/dt into ``out``/``rate`` (M, C, 4) at columns ``live`` (L,), intervals ``interval`` (L,) s,
     coefficient rows (z0, z1, z2) ``coef`` (L, J, 3, 4) of the intervals ``first`` (L,) + 0 .. J - 1."""

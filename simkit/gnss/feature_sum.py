@@ -47,7 +47,7 @@ def _sincos(x):
     return sin_x, cos_x
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _base(k, w, phase, x, t, sin_a, cos_a, reach):
     """sin and cos of the phases k . x + w t + phase of every feature at one point ``x`` (3,) and time ``t``."""
     bound = reach[0] * math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) + reach[1] * abs(t) + reach[2]
@@ -60,7 +60,7 @@ def _base(k, w, phase, x, t, sin_a, cos_a, reach):
         sin_a[f], cos_a[f] = math.sin(a), math.cos(a)
 
 
-@numba.njit(cache=True, fastmath=_SUM)
+@numba.njit(cache=True, nogil=True, fastmath=_SUM)
 def _member(k, w, phase, sin_a, cos_a, x, x0, t, dt, reach):
     """sum_f cos(phase_f at ``x``, ``t`` + ``dt``) from the base point ``x0`` at ``t`` (sines and cosines);
     ``reach`` (max |k_f|, max |w_f|) bounds |d|."""
@@ -79,7 +79,7 @@ def _member(k, w, phase, sin_a, cos_a, x, x0, t, dt, reach):
     return total
 
 
-@numba.njit(cache=True, fastmath=_SUM)
+@numba.njit(cache=True, nogil=True, fastmath=_SUM)
 def _clusters(k, w, phase, reach, x, t, dt, out):
     n_feat = k.shape[1]
     sin_a, cos_a = np.empty(n_feat), np.empty(n_feat)

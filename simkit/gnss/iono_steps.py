@@ -102,7 +102,7 @@ def _pierce(lat, sin_lat, cos_lat, sin_lon, cos_lon, sin_az, cos_az, sin_el, cos
     return r * cos_p * cos_l, r * cos_p * sin_l, r * sin_p
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _steps(bds, alpha, beta, lat, lon, lat_rate, lon_rate, az, el, az_rate, el_rate, sow, steps, shell_ratio,
            shell_r, klob, points):
     for m in range(az.shape[0]):

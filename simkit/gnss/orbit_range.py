@@ -28,7 +28,7 @@ def _ecef_error(p0, p1, p2, w0, w1, w2, r, a, c):
     return r0 * r + a0 * a + k0 * c, r1 * r + a1 * a + k1 * c, r2 * r + a2 * a + k2 * c
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _ranges(los, rng, rel, pos, vel, v_in, rac, rac_rate, steps, out):
     d = np.empty((steps.shape[0], 3))
     for m in range(los.shape[0]):

@@ -22,10 +22,15 @@ and the Saastamoinen 1/sin(el) models that a receiver applies; each departure is
 """
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Iterable, Iterator
+
 import numpy as np
 
 from .. import frames, gpstime, rng
 from ..constellation import Sky, antenna_view, time_offsets
+from ..constellation.antennas import AntennaView
 from ..constellation.geometry import RECEPTION_GRID_S
 from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
@@ -54,6 +59,25 @@ _DEFAULT_KLOBUCHAR = {"G": (atmosphere.DEFAULT_GPS_ALPHA, atmosphere.DEFAULT_GPS
                       "C": (atmosphere.DEFAULT_BDS_ALPHA, atmosphere.DEFAULT_BDS_BETA)}
 # the broadcast ionosphere model each system's delays come from: Galileo, QZSS and GLONASS use the GPS
 # Klobuchar model and coefficients, scaled from L1 to each carrier (one ionosphere for every line of sight)
+
+
+@dataclass(frozen=True)
+class BlockGeometry:
+    """What :meth:`GnssSimulator.geometry` computes for a block of M epochs: times ``t`` (M,) s since the start
+    and GPS ``week``/``sow`` (M,), antenna positions and velocities (M, A, 3) ECEF, the body-to-ECEF matrices
+    ``c_be`` (M, 3, 3), the light-time solution ``ref`` at the IMU centre (:meth:`simkit.constellation.Sky.view`),
+    the candidate satellite columns ``cand`` (C,) and their per-antenna ``view``
+    (:func:`simkit.constellation.antenna_view`)."""
+
+    t: np.ndarray
+    week: np.ndarray
+    sow: np.ndarray
+    ant_pos: np.ndarray
+    ant_vel: np.ndarray
+    c_be: np.ndarray
+    ref: dict
+    cand: np.ndarray
+    view: AntennaView
 
 
 class GnssSimulator:
@@ -191,6 +215,34 @@ class GnssSimulator:
         Per-antenna work is done only for the satellites near or above the elevation mask (with an environment:
         above the horizon) at some epoch of the block (the candidate columns); the arrays are NaN elsewhere.
         """
+        return self.observe(self.geometry(t, pos_ecef, vel_ecef, quat_nb, omega_ib_b))
+
+    def process_blocks(self, blocks: Iterable[tuple], ahead: bool = True) -> Iterator[GnssEpochs]:
+        """:meth:`process` of each block (t, pos_ecef, vel_ecef, quat_nb, omega_ib_b) of ``blocks``, in order.
+        ``ahead``: the geometry of block k + 1 (:meth:`geometry`, which depends on that block's truth alone) is
+        computed on a worker thread while block k's errors and observables are formed (the compiled passes
+        release the GIL, so the two share two cores); the same arrays as :meth:`process`. ``blocks`` is iterated
+        on the calling thread."""
+        blocks = iter(blocks)
+        if not ahead:
+            for b in blocks:
+                yield self.process(*b)
+            return
+        first = next(blocks, None)
+        if first is None:
+            return
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="simkit-gnss-geometry") as worker:
+            pending = worker.submit(self.geometry, *first)
+            while pending is not None:
+                b = next(blocks, None)
+                geo = pending.result()
+                pending = worker.submit(self.geometry, *b) if b is not None else None
+                yield self.observe(geo)
+
+    def geometry(self, t, pos_ecef, vel_ecef, quat_nb, omega_ib_b) -> BlockGeometry:
+        """The part of :meth:`process` that depends on the block's truth alone (no state carried between
+        blocks, so blocks may run ahead): antenna positions, the light-time solution at the IMU centre, the
+        candidate columns and the per-antenna view of them."""
         t = np.asarray(t, dtype=float)
         pos = np.asarray(pos_ecef, dtype=float).reshape(t.size, 3)
         week, sow = gpstime.add_seconds(self.start_week, self.start_sow, t)
@@ -201,17 +253,23 @@ class GnssSimulator:
         with np.errstate(invalid="ignore"):
             cand = np.flatnonzero((ref["elevation"] >= low - _MASK_MARGIN_RAD).any(axis=0))
         view = antenna_view({k: v[:, cand] for k, v in ref.items()}, ant_pos, ant_vel)
+        return BlockGeometry(t, week, sow, ant_pos, ant_vel, c_be, ref, cand, view)
+
+    def observe(self, geo: BlockGeometry) -> GnssEpochs:
+        """The rest of :meth:`process`, in block order (clocks, random draws, multipath and tracking carry their
+        state from one block to the next): visibility, error terms and observables."""
+        t, cand, view = geo.t, geo.cand, geo.view
         los = None
         if self.env is not None:
-            los = self.env.classify(ant_pos, view.lla, view.vel_enu, view.los, view.azimuth, view.elevation,
-                                    view.azimuth_rate, view.elevation_rate, c_be)
-        vis_c, off = self._visibility(t, view, c_be, cand, los)
+            los = self.env.classify(geo.ant_pos, view.lla, view.vel_enu, view.los, view.azimuth, view.elevation,
+                                    view.azimuth_rate, view.elevation_rate, geo.c_be)
+        vis_c, off = self._visibility(t, view, geo.c_be, cand, los)
         vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         k0 = int(round(t[0] * self.cfg.rate_hz))
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
-        parts = _Parts(self, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los)
-        return GnssEpochs(t=t, sat_pos_ecef=ref["sat_pos_emission"], sat_clock=ref["sat_clock"],
-                          truth=parts.truth(ant_pos, ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
+        parts = _Parts(self, t, geo.week, geo.sow, cand, view, vis_c, off, draws, geo.ref, geo.ant_vel, los)
+        return GnssEpochs(t=t, sat_pos_ecef=geo.ref["sat_pos_emission"], sat_clock=geo.ref["sat_clock"],
+                          truth=parts.truth(geo.ant_pos, geo.ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
 
     # ------------------------------------------------------------------ steps
     def _visibility(self, t, view, c_be, cand, los: LineOfSight | None = None):

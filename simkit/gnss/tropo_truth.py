@@ -69,7 +69,7 @@ def niell_mapping(lat, h, el, doy):
     return m_h, m_w
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _slants(niell, el, el_rate, steps, hyd, wet, height, zhd, zwd, model_zenith, out):
     """Truth slant delays at the time steps and the receiver's model delay, per receiver r and line of sight c:
     ``out[j]`` (J, R, C) at elevation el + steps[j] el_rate (steps[0] = 0: el itself), ``out[J]`` the model
