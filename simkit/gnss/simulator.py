@@ -66,8 +66,8 @@ class BlockGeometry:
     """What :meth:`GnssSimulator.geometry` computes for a block of M epochs: times ``t`` (M,) s since the start
     and GPS ``week``/``sow`` (M,), antenna positions and velocities (M, A, 3) ECEF, the body-to-ECEF matrices
     ``c_be`` (M, 3, 3), the light-time solution ``ref`` at the IMU centre (:meth:`simkit.constellation.Sky.view`),
-    the candidate satellite columns ``cand`` (C,) and their per-antenna ``view``
-    (:func:`simkit.constellation.antenna_view`)."""
+    the candidate satellite columns ``cand`` (C,), their per-antenna ``view``
+    (:func:`simkit.constellation.antenna_view`) and the ``atmosphere`` along it."""
 
     t: np.ndarray
     week: np.ndarray
@@ -78,6 +78,7 @@ class BlockGeometry:
     ref: dict
     cand: np.ndarray
     view: AntennaView
+    atmosphere: _Atmosphere
 
 
 class GnssSimulator:
@@ -242,7 +243,7 @@ class GnssSimulator:
     def geometry(self, t, pos_ecef, vel_ecef, quat_nb, omega_ib_b) -> BlockGeometry:
         """The part of :meth:`process` that depends on the block's truth alone (no state carried between
         blocks, so blocks may run ahead): antenna positions, the light-time solution at the IMU centre, the
-        candidate columns and the per-antenna view of them."""
+        candidate columns, the per-antenna view of them and the atmosphere along it."""
         t = np.asarray(t, dtype=float)
         pos = np.asarray(pos_ecef, dtype=float).reshape(t.size, 3)
         week, sow = gpstime.add_seconds(self.start_week, self.start_sow, t)
@@ -253,7 +254,8 @@ class GnssSimulator:
         with np.errstate(invalid="ignore"):
             cand = np.flatnonzero((ref["elevation"] >= low - _MASK_MARGIN_RAD).any(axis=0))
         view = antenna_view({k: v[:, cand] for k, v in ref.items()}, ant_pos, ant_vel)
-        return BlockGeometry(t, week, sow, ant_pos, ant_vel, c_be, ref, cand, view)
+        return BlockGeometry(t, week, sow, ant_pos, ant_vel, c_be, ref, cand, view,
+                             _Atmosphere(self, t, week, sow, cand, view))
 
     def observe(self, geo: BlockGeometry) -> GnssEpochs:
         """The rest of :meth:`process`, in block order (clocks, random draws, multipath and tracking carry their
@@ -267,7 +269,8 @@ class GnssSimulator:
         vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         k0 = int(round(t[0] * self.cfg.rate_hz))
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
-        parts = _Parts(self, t, geo.week, geo.sow, cand, view, vis_c, off, draws, geo.ref, geo.ant_vel, los)
+        parts = _Parts(self, t, geo.week, geo.sow, cand, view, vis_c, off, draws, geo.ref, geo.ant_vel,
+                       geo.atmosphere, los)
         return GnssEpochs(t=t, sat_pos_ecef=geo.ref["sat_pos_emission"], sat_clock=geo.ref["sat_clock"],
                           truth=parts.truth(geo.ant_pos, geo.ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
 
@@ -314,10 +317,86 @@ class GnssSimulator:
                 noise.fll_sigma_hz(cn0, nz.fll_bandwidth_hz, nz.integration_time_s))
 
 
+class _Atmosphere:
+    """The troposphere and the ionosphere along the lines of sight of a block's candidate columns: elevation
+    ``el`` (M, A, C) rad (kept above 1 mrad, zenith where unknown) and azimuth ``az``; ``trop``, ``trop_rate``,
+    ``trop_error`` and ``iono``, ``iono_rate``, ``iono_error`` (M, A, C) m, m/s, m. Depends on the block's
+    geometry alone (the truth models are fixed for the run), so it is computed with it."""
+
+    def __init__(self, sim: GnssSimulator, t, week, sow, cand, view):
+        self.sim, self.t, self.week, self.sow, self.cand, self.view = sim, t, week, sow, cand, view
+        err = sim.cfg.errors
+        self.el = np.where(np.isfinite(view.elevation), np.maximum(view.elevation, 1e-3), np.pi / 2)
+        self.az = np.where(np.isfinite(view.azimuth), view.azimuth, 0.0)
+        self._troposphere(err)
+        self._ionosphere(err)
+
+    def _troposphere(self, err):
+        """Slant delay (M, A, C) m, its rate and the truth minus the receiver's model."""
+        view = self.view
+        lat, hgt = view.lla[..., 0, None], view.lla[..., 2, None]
+        self.trop_error = np.zeros(self.el.shape)
+        if err["troposphere"] and self.sim.truth_tropo is not None:
+            self.trop, self.trop_rate, model = self.sim.truth_tropo.slant(
+                lat, hgt, self.el, view.vel_enu[..., 2, None], view.elevation_rate, self.t[:, None, None])
+            self.trop_error = self.trop - model
+        elif err["troposphere"]:
+            self.trop = atmosphere.troposphere(lat, hgt, self.el)
+            self.trop_rate = atmosphere.troposphere_rate(lat, hgt, self.el, view.vel_enu[..., 2, None],
+                                                         view.elevation_rate)
+        else:
+            self.trop = self.trop_rate = np.zeros(self.el.shape)
+
+    def _ionosphere(self, err):
+        """Delay (M, A, C) m at each model's reference frequency (L1 for GPS, Galileo, QZSS, GLONASS; B1I for
+        BDS), its rate, and the truth minus the broadcast model.
+
+        A truth that departs from the broadcast model is evaluated along the first antenna's lines of sight and
+        shared by every antenna of the vehicle: antennas metres apart see a satellite within a microradian of each
+        other, through pierce points metres apart on fields that vary over hundreds of kilometres (Klobuchar, the
+        truth's random field, a map's 2.5 deg cells), so their delays differ by tens of micrometres (at most
+        3.4e-5 m, near the horizon on B3I, on xian_static_bds's 9.4 m baseline: ``benchmarks/gnss_ab.py``), a
+        fiftieth of the carrier noise. The broadcast model, which a receiver evaluates at its own antenna, is taken
+        per antenna, so that truth minus the stored model error is exactly the receiver's correction."""
+        self.iono = np.zeros(self.el.shape)
+        self.iono_rate = np.zeros(self.el.shape)
+        self.iono_error = np.zeros(self.el.shape)
+        if not err["ionosphere"]:
+            return
+        view, system, truth = self.view, self.sim.iono_model[self.cand], self.sim.truth_iono
+        sow = self.sow[:, None, None]
+        first = slice(0, 1)
+        for letter in "GC":
+            cols = system == letter
+            if not cols.any():
+                continue
+            alpha, beta = self.sim.iono[letter]
+            if truth is None:
+                self.iono[..., cols], self.iono_rate[..., cols] = atmosphere.ionosphere(
+                    letter, alpha, beta, view.lla, view.vel_enu, self.az[..., cols], self.el[..., cols],
+                    view.azimuth_rate[..., cols], view.elevation_rate[..., cols], sow)
+                continue
+            iono, rate, klob = truth.delay(
+                letter, alpha, beta, view.lla[:, first], view.vel_enu[:, first], self.az[:, first][..., cols],
+                self.el[:, first][..., cols], view.azimuth_rate[:, first][..., cols],
+                view.elevation_rate[:, first][..., cols], self.week[:, None, None], sow, self.t[:, None, None])
+            seen = np.isfinite(view.range[:, first][..., cols])
+            if not np.all(np.isfinite(iono)[seen]):
+                raise DataFileError(truth.ionex.path, "the TEC maps have no value at a pierce point of the run "
+                                    "(a regional map, or missing values)")
+            if self.sim.n_ant > 1:
+                others = slice(1, None)
+                klob = np.concatenate([klob, klobuchar_delays(
+                    letter, alpha, beta, view.lla[:, others, 0], view.lla[:, others, 1],
+                    self.az[:, others][..., cols], self.el[:, others][..., cols], self.sow)], axis=1)
+            self.iono[..., cols], self.iono_rate[..., cols] = iono, rate
+            self.iono_error[..., cols] = iono - klob
+
+
 class _Parts:
     """The error terms and observables of one block, computed step by step on the candidate columns."""
 
-    def __init__(self, sim: GnssSimulator, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los=None):
+    def __init__(self, sim: GnssSimulator, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, atmo, los=None):
         self.sim, self.cand, self.view, self.m, self.los = sim, cand, view, t.size, los
         self.t, self.week, self.sow = t, week, sow
         self.shape = (t.size, sim.n_ant, len(sim.sat_ids))
@@ -335,10 +414,9 @@ class _Parts:
             reacquire = switch[..., None] & sim.carries[None, None, :, :]
         self._clocks(err)
         self._ephemeris(err, ref, ant_vel)
-        self.el = np.where(np.isfinite(view.elevation), np.maximum(view.elevation, 1e-3), np.pi / 2)
-        self.az = np.where(np.isfinite(view.azimuth), view.azimuth, 0.0)
-        self._troposphere(err)
-        self._ionosphere(err)
+        self.el, self.az = atmo.el, atmo.az
+        self.trop, self.trop_rate, self.trop_error = atmo.trop, atmo.trop_rate, atmo.trop_error
+        self.iono, self.iono_rate, self.iono_error = atmo.iono, atmo.iono_rate, atmo.iono_error
         self.mp = sim.mp.advance(draws[..., 3:5], restart, index=(slice(None), cand)) if err["multipath"] else None
         amb, lli = sim.tracking.advance(t, tracked, reacquire)
         self.obs, self.signal_truth = {}, {}
@@ -400,66 +478,6 @@ class _Parts:
         self.orb = orb[0]
         self.orb_rate = (orb[1] - orb[2]) / (2.0 * h)
         self.range, self.range_rate = view.range + self.orb, view.range_rate + self.orb_rate
-
-    def _troposphere(self, err):
-        view = self.view
-        lat, hgt = view.lla[..., 0, None], view.lla[..., 2, None]
-        self.trop_error = np.zeros(self.el.shape)
-        if err["troposphere"] and self.sim.truth_tropo is not None:
-            self.trop, self.trop_rate, model = self.sim.truth_tropo.slant(
-                lat, hgt, self.el, view.vel_enu[..., 2, None], view.elevation_rate, self.t[:, None, None])
-            self.trop_error = self.trop - model
-        elif err["troposphere"]:
-            self.trop = atmosphere.troposphere(lat, hgt, self.el)
-            self.trop_rate = atmosphere.troposphere_rate(lat, hgt, self.el, view.vel_enu[..., 2, None],
-                                                         view.elevation_rate)
-        else:
-            self.trop = self.trop_rate = np.zeros(self.el.shape)
-
-    def _ionosphere(self, err):
-        """Delay (M, A, C) m at each model's reference frequency (L1 for GPS, Galileo, QZSS, GLONASS; B1I for
-        BDS), its rate, and the truth minus the broadcast model.
-
-        A truth that departs from the broadcast model is evaluated along the first antenna's lines of sight and
-        shared by every antenna of the vehicle: antennas metres apart see a satellite within a microradian of each
-        other, through pierce points metres apart on fields that vary over hundreds of kilometres (Klobuchar, the
-        truth's random field, a map's 2.5 deg cells), so their delays differ by tens of micrometres (at most
-        3.4e-5 m, near the horizon on B3I, on xian_static_bds's 9.4 m baseline: ``benchmarks/gnss_ab.py``), a
-        fiftieth of the carrier noise. The broadcast model, which a receiver evaluates at its own antenna, is taken
-        per antenna, so that truth minus the stored model error is exactly the receiver's correction."""
-        self.iono = np.zeros(self.el.shape)
-        self.iono_rate = np.zeros(self.el.shape)
-        self.iono_error = np.zeros(self.el.shape)
-        if not err["ionosphere"]:
-            return
-        view, system, truth = self.view, self.sim.iono_model[self.cand], self.sim.truth_iono
-        sow = self.sow[:, None, None]
-        first = slice(0, 1)
-        for letter in "GC":
-            cols = system == letter
-            if not cols.any():
-                continue
-            alpha, beta = self.sim.iono[letter]
-            if truth is None:
-                self.iono[..., cols], self.iono_rate[..., cols] = atmosphere.ionosphere(
-                    letter, alpha, beta, view.lla, view.vel_enu, self.az[..., cols], self.el[..., cols],
-                    view.azimuth_rate[..., cols], view.elevation_rate[..., cols], sow)
-                continue
-            iono, rate, klob = truth.delay(
-                letter, alpha, beta, view.lla[:, first], view.vel_enu[:, first], self.az[:, first][..., cols],
-                self.el[:, first][..., cols], view.azimuth_rate[:, first][..., cols],
-                view.elevation_rate[:, first][..., cols], self.week[:, None, None], sow, self.t[:, None, None])
-            seen = np.isfinite(view.range[:, first][..., cols])
-            if not np.all(np.isfinite(iono)[seen]):
-                raise DataFileError(truth.ionex.path, "the TEC maps have no value at a pierce point of the run "
-                                    "(a regional map, or missing values)")
-            if self.sim.n_ant > 1:
-                others = slice(1, None)
-                klob = np.concatenate([klob, klobuchar_delays(
-                    letter, alpha, beta, view.lla[:, others, 0], view.lla[:, others, 1],
-                    self.az[:, others][..., cols], self.el[:, others][..., cols], self.sow)], axis=1)
-            self.iono[..., cols], self.iono_rate[..., cols] = iono, rate
-            self.iono_error[..., cols] = iono - klob
 
     def _signal(self, j, g, off, draws, tracked, amb, lli):
         """Observables and error terms of signal ``g`` (index ``j``) on the columns that transmit it."""
