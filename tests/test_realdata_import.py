@@ -15,6 +15,7 @@ from realdata_helpers import (BERLIN_NAV, BERLIN_OBS, KMS3_HEADER_POS, KMS3_NAV,
                               rinex4_nav_as_rinex3, rtklib_spp)
 from simkit.cli import main
 from simkit.gnss import rinex_obs
+from simkit.io import read_gnss
 
 
 def _import(tmp_path, obs, nav=(), name="real.h5", extra=()):
@@ -53,6 +54,27 @@ def test_kms3_file_has_the_simulated_layout_without_truth(kms3):
     gps = parsed.systems["G"]
     assert report["skipped_codes"]["G C1W"] == int(np.isfinite(gps.values[..., gps.types.index("C1W")]).sum())
     assert report["observations"]["L1C"]["code"] == int(np.isfinite(gps.values[..., gps.types.index("C1C")]).sum())
+
+
+def test_glonass_carriers_take_each_satellites_frequency_number(kms3):
+    """KMS3's header lists the GLONASS frequency numbers ('GLONASS SLOT / FRQ #'): G1 = 1602 + 0.5625 k MHz and
+    G2 = 1246 + 0.4375 k MHz per satellite (ICD GLONASS 5.1), the CDMA signals their own frequency."""
+    with simkit.open(kms3) as ds:
+        sats = [str(s) for s in ds["gnss/sat_id"][:]]
+        sigs = [str(s) for s in ds["gnss/signals"][:]]
+        freq = ds["gnss/sat_frequency_hz"][:]
+        nominal = ds["gnss/frequency_hz"][:]
+        g = read_gnss(ds, antennas=0, satellites=False)
+    channels = rinex_obs.read(KMS3_OBS).header.glonass_channels
+    assert channels["R10"] == -7 and channels["R03"] == 5 and len(channels) == 10
+    g1, g2 = sigs.index("G1C"), sigs.index("G2C")
+    for sat, k in channels.items():
+        if sat in sats:
+            i = sats.index(sat)
+            assert freq[i, g1] == 1602e6 + 0.5625e6 * k and freq[i, g2] == 1246e6 + 0.4375e6 * k
+    cdma = [j for j, n in enumerate(sigs) if n not in ("G1C", "G2C")]
+    np.testing.assert_array_equal(freq[:, cdma], np.broadcast_to(nominal[cdma], (len(sats), len(cdma))))
+    np.testing.assert_allclose(g.sat_wavelength_m, 299792458.0 / freq)
 
 
 def test_satellites_sit_where_the_pseudoranges_say(kms3):

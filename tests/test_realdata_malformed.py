@@ -231,3 +231,22 @@ def test_a_file_of_systems_simkit_does_not_know_is_one_line(tmp_path):
     body = ["> 2016 06 06 11 00 00.0000000  0  1", "S20  21000000.123 7 110355000.456 7"]
     with pytest.raises(DataFileError, match="no observation of a signal simkit knows .* the file has S: C1C L1C"):
         importer.import_rinex(_write(tmp_path, header, body))
+
+
+@pytest.mark.parametrize("line, what", [
+    ("  2 R03  5 R04 x6", "frequency number 'x6' of R04"),
+    ("  2 R03  5 R04 14", "frequency number '14' of R04"),
+    ("  1 G03  5", "bad satellite 'G03'"),
+])
+def test_a_bad_glonass_slot_record_is_one_line(tmp_path, line, what):
+    header = HEADER[:-1] + [_h(line, "GLONASS SLOT / FRQ #")] + HEADER[-1:]
+    text = _error(_write(tmp_path, header=header))
+    assert what in text and "GLONASS SLOT / FRQ #" in text and ".rnx:8:" in text
+
+
+def test_glonass_slot_records_give_the_frequency_numbers(tmp_path):
+    header = HEADER[:-1] + [_h(" 10 R03  5 R04  6 R05  1 R10 -7 R11  0 R12 -1 R13 -2 R20  2", "GLONASS SLOT / FRQ #"),
+                            _h("    R21  4 R23  3", "GLONASS SLOT / FRQ #")] + HEADER[-1:]
+    channels = rinex_obs.read(_write(tmp_path, header=header)).header.glonass_channels
+    assert channels == {"R03": 5, "R04": 6, "R05": 1, "R10": -7, "R11": 0, "R12": -1, "R13": -2, "R20": 2,
+                        "R21": 4, "R23": 3}

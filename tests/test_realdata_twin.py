@@ -44,6 +44,29 @@ def test_multipath_combination_cancels_range_ionosphere_and_ambiguity():
     assert abs(np.nanmean(mp["L1C"])) < 1e-9 + 0.3 / np.sqrt(400)
 
 
+def test_glonass_multipath_needs_each_satellites_own_frequency():
+    """G1C/G2C of satellites on channels -7, 0 and +6: with each satellite's wavelengths (per-satellite
+    frequencies, (S, G)) the combination is the code noise; with the nominal channel-0 frequencies it is not."""
+    g1, g2 = sigmod.get("G1C"), sigmod.get("G2C")
+    k = np.array([-7.0, 0.0, 6.0])
+    f1, f2 = g1.frequency_for(k), g2.frequency_for(k)
+    rng = np.random.default_rng(5)
+    m, s = 400, 3
+    t = np.arange(m) * 1.0
+    rho = 2.2e7 + 500.0 * t[:, None] + 1e5 * np.arange(s)
+    iono1 = 3.0 + 1e-3 * t[:, None] + np.zeros((1, s))
+    obs = {kind: {} for kind in twin.KINDS}
+    for g, f in ((g1, f1), (g2, f2)):
+        i = iono1 * (f1 / f) ** 2
+        obs["code"][g.name] = rho + i + 0.3 * rng.standard_normal((m, s))
+        obs["carrier"][g.name] = (rho - i + 0.002 * rng.standard_normal((m, s))) * f / 299792458.0
+        obs["lli"][g.name] = np.zeros((m, s), np.uint8)
+    per_sat = fidelity.multipath(obs, ["G1C", "G2C"], np.stack([f1, f2], axis=1), t)
+    nominal = fidelity.multipath(obs, ["G1C", "G2C"], [g1.freq_hz, g2.freq_hz], t)
+    assert np.nanstd(per_sat["G1C"]) == pytest.approx(0.3, rel=0.08)
+    assert np.nanstd(nominal["G1C"][:, 0]) > 3.0          # channel -7 read as channel 0: metres of drift
+
+
 def test_an_lli_flag_starts_a_new_arc():
     t, obs = _dual()
     obs["carrier"]["L1C"][200:, 0] += 17.0                 # a slip of 17 cycles, flagged
@@ -61,7 +84,7 @@ def test_carrier_noise_of_white_phase_from_third_differences():
 
 def test_doppler_residual_is_the_doppler_noise():
     t, obs = _dual()
-    res = fidelity.doppler_residual(obs, ["L1C"], [L1.freq_hz], t)["L1C"]
+    res = fidelity.doppler_residual(obs, ["L1C"], t)["L1C"]
     phase_rate_noise = 0.002 / L1.wavelength_m / np.sqrt(2)   # (e_k+1 - e_k-1) / 2 dt
     assert fidelity.robust_std(res) == pytest.approx(np.hypot(0.05, phase_rate_noise), rel=0.08)
 
@@ -77,7 +100,8 @@ def test_cn0_fit_recovers_the_simulator_model():
     rng = np.random.default_rng(3)
     m, s = 50, 8
     el = np.radians(rng.uniform(5, 85, (m, s)))
-    real = {"t": np.arange(m) * 30.0, "signals": ["L1C"], "freq": [L1.freq_hz], "obs": {k: {} for k in twin.KINDS}}
+    real = {"t": np.arange(m) * 30.0, "signals": ["L1C"], "freq": [L1.freq_hz], "sat_freq": [L1.freq_hz],
+            "obs": {k: {} for k in twin.KINDS}}
     cn0 = 42.0 + L1.cn0_offset_db - 14.0 * ((np.pi / 2 - el) / (np.pi / 2)) ** 2 + 0.3 * rng.standard_normal((m, s))
     t, obs = _dual(m=m, s=s)
     real["obs"] = {k: {"L1C": obs[k]["L1C"]} for k in twin.KINDS}

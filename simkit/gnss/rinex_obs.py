@@ -44,7 +44,8 @@ _V2_GLO = {"C1": "C1C", "P1": "C1P", "C2": "C2C", "P2": "C2P"}
 class ObsHeader:
     """What the importer needs of a RINEX observation header. ``obs_types`` {system letter: [RINEX 3 codes]};
     ``approx_pos_ecef`` (3,) m or None; ``antenna_delta_hen`` (3,) m height, east, north of the antenna reference
-    point above the marker; ``time_system`` 'GPS', 'GAL' or 'BDT'; ``interval_s`` or None."""
+    point above the marker; ``time_system`` 'GPS', 'GAL' or 'BDT'; ``interval_s`` or None; ``glonass_channels``
+    each GLONASS satellite's FDMA frequency number k (-7..+13) where the header lists it."""
 
     version: float
     file_system: str
@@ -57,6 +58,7 @@ class ObsHeader:
     time_system: str
     interval_s: float | None
     clock_offset_applied: bool
+    glonass_channels: dict = field(default_factory=dict)   # {"R03": k}: 'GLONASS SLOT / FRQ #' (RINEX >= 3.02)
 
 
 @dataclass(frozen=True)
@@ -169,6 +171,7 @@ class _HeaderState:
         self.v2_types: list[str] = []
         self.n_v2 = None
         self.pending = None  # (system, announced count) of the RINEX 3 obs-types record being read
+        self.channels: dict[str, int] = {}
 
     def _check_pending(self, i):
         if self.pending and len(self.types[self.pending[0]]) != self.pending[1]:
@@ -204,6 +207,27 @@ class _HeaderState:
             self.v2_types += line[6:60].split()
         elif label == "SYS / # / OBS TYPES" and self.version >= 3:
             self._obs_types(line, i)
+        elif label == "GLONASS SLOT / FRQ #":
+            self._glonass_slots(line, i)
+
+    def _glonass_slots(self, line, i):
+        """Up to eight 'Rnn kk' entries from column 5, seven characters each (RINEX 3.02+)."""
+        for k in range(8):
+            entry = line[4 + 7 * k:10 + 7 * k]
+            if not entry.strip():
+                continue
+            sat, chan = entry[:3].replace(" ", "0"), entry[3:].strip()
+            if not (sat[0] == "R" and sat[1:].isdigit()):
+                raise DataFileError(self.path, f"'GLONASS SLOT / FRQ #': bad satellite {entry[:3]!r} (expected R01 "
+                                    "..)", i)
+            try:
+                value = int(chan)
+            except ValueError:
+                value = None
+            if value is None or not -7 <= value <= 13:
+                raise DataFileError(self.path, f"'GLONASS SLOT / FRQ #': frequency number {chan!r} of {sat} "
+                                    "(expected an integer -7 .. 13)", i)
+            self.channels[sat] = value
 
     def _obs_types(self, line, i):
         sys = line[0:1]
@@ -238,7 +262,8 @@ class _HeaderState:
             raise DataFileError(path, f"time system {tsys!r} of 'TIME OF FIRST OBS' is not supported "
                                 f"(expected {', '.join(SUPPORTED_TIME_SYSTEMS)})")
         return ObsHeader(self.version, self.file_sys, info["marker"], info["receiver"], info["antenna"],
-                         info["pos"], info["delta"], self.types, tsys, info["interval"], info["applied"])
+                         info["pos"], info["delta"], self.types, tsys, info["interval"], info["applied"],
+                         self.channels)
 
 
 def _sat_id(text: str, path, line: int, default: str) -> str:

@@ -87,7 +87,8 @@ _GNSS = [
     _f("gnss/wavelength_m", "f8", ("G",), "m", "", "gnss", "carrier wavelength per signal"),
     _f("gnss/sat_frequency_hz", "f8", ("S", "G"), "Hz", "", "gnss",
        "carrier frequency per satellite and signal: frequency_hz, except GLONASS FDMA signals (channel k: "
-       "G1 1602 + 0.5625 k MHz, G2 1246 + 0.4375 k MHz); wavelength = c / this"),
+       "G1 1602 + 0.5625 k MHz, G2 1246 + 0.4375 k MHz; NaN in an imported file that gives no k for a satellite); "
+       "wavelength = c / this"),
     _f("gnss/group_delay", "f8", ("S", "G"), "m", "", "gnss", "code group delay applied (c TGD-type term)"),
     _f("gnss/iono_systems", "str", ("Y",), "", "", "gnss",
        "systems of the rows of iono_alpha/iono_beta: 'G' (GPS, L1 model) or 'C' (BDS, B1I model)"),

@@ -127,12 +127,27 @@ def pairs(signals, systems_of_signals, freq) -> dict:
     return out
 
 
+def _per_satellite(signals, freq) -> dict:
+    """{signal: carrier frequency Hz, a number or (S,) per satellite} from ``freq`` (G,) or (S, G) (GLONASS FDMA:
+    each satellite its own; NaN where unknown)."""
+    freq = np.asarray(freq, dtype=float)
+    return {s: (freq[j] if freq.ndim == 1 else freq[:, j]) for j, s in enumerate(signals)}
+
+
+def nominal(signals) -> np.ndarray:
+    """Each signal's nominal carrier frequency (G,) Hz (channel 0 for FDMA)."""
+    from ..gnss import signals as sigmod
+
+    return np.array([sigmod.get(s).freq_hz for s in signals])
+
+
 def multipath(obs, signals, freq, t) -> dict:
-    """{signal: (M, S) code multipath-plus-noise series, m, zero-mean per arc} (module docstring)."""
-    wl = {s: C_LIGHT / f for s, f in zip(signals, freq)}
-    fr = dict(zip(signals, freq))
+    """{signal: (M, S) code multipath-plus-noise series, m, zero-mean per arc} (module docstring); ``freq`` (G,) or
+    per satellite (S, G) Hz."""
+    fr = _per_satellite(signals, freq)
+    wl = {s: C_LIGHT / f for s, f in fr.items()}
     sys_of = [_system(s) for s in signals]
-    partner = pairs(signals, sys_of, freq)
+    partner = pairs(signals, sys_of, nominal(signals))
     out = {}
     for s in signals:
         p, li = obs["code"][s], obs["carrier"][s] * wl[s]
@@ -158,9 +173,10 @@ def _system(signal: str) -> str:
 
 
 def carrier_noise(obs, signals, freq, t) -> dict:
-    """{"A+B": (M, S) third differences of the geometry-free phase / sqrt(20), m} for each dual-frequency pair."""
-    wl = {s: C_LIGHT / f for s, f in zip(signals, freq)}
-    partner = pairs(signals, [_system(s) for s in signals], freq)
+    """{"A+B": (M, S) third differences of the geometry-free phase / sqrt(20), m} for each dual-frequency pair;
+    ``freq`` (G,) or per satellite (S, G) Hz."""
+    wl = {s: C_LIGHT / f for s, f in _per_satellite(signals, freq).items()}
+    partner = pairs(signals, [_system(s) for s in signals], nominal(signals))
     out = {}
     done = set()
     for a, b in partner.items():
@@ -177,10 +193,10 @@ def carrier_noise(obs, signals, freq, t) -> dict:
     return out
 
 
-def doppler_residual(obs, signals, freq, t) -> dict:
+def doppler_residual(obs, signals, t) -> dict:
     """{signal: (M, S) Doppler minus the carrier-phase rate (central differences), Hz} where both exist."""
     out = {}
-    for s, f in zip(signals, freq):
+    for s in signals:
         d, phi = obs["doppler"][s], obs["carrier"][s]
         if not np.isfinite(d).any():
             continue

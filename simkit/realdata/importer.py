@@ -146,9 +146,11 @@ def build(obs: ObsFile, nav_paths=(), reference=None, reference_source=None) -> 
               "reference": reference_source or "none"}
     week, sow0 = obs.start
     sow = sow0 + obs.t
-    pos, clk, gd, iono = _satellites(obs, nav_paths, sats, signals, first_code, reference, report)
+    pos, clk, gd, iono, nav_channels = _satellites(obs, nav_paths, sats, signals, first_code, reference, report)
     ds.update({"gnss/t": obs.t, "gnss/sat_id": np.array(sats), "gnss/signals": np.array(signals),
                "gnss/frequency_hz": np.array([sigmod.get(n).freq_hz for n in signals]),
+               "gnss/sat_frequency_hz": _sat_frequencies(sats, signals, obs.header.glonass_channels, nav_channels,
+                                                         report),
                "gnss/wavelength_m": np.array([sigmod.get(n).wavelength_m for n in signals]),
                "gnss/group_delay": gd, "gnss/sat_pos_ecef": pos, "gnss/sat_clock": clk,
                "gnss/antennas/lever_arm_b": np.zeros((1, 3)),
@@ -204,7 +206,7 @@ def _satellites(obs, nav_paths, sats, signals, first_code, reference, report):
     gd = np.zeros((n_s, len(signals)))
     if not nav_paths:
         report["navigation"] = "none: satellite orbits and clocks are NaN (give --nav)"
-        return pos, clk, gd, {}
+        return pos, clk, gd, {}, {}
     sky = load_sky(nav_paths)
     used_sys = sorted({s[0] for s in sats}, key=SYSTEM_ORDER.find)
     nav_sys = sorted({s[0] for c in sky.constellations for s in c.sat_ids}, key=SYSTEM_ORDER.find)
@@ -255,7 +257,30 @@ def _satellites(obs, nav_paths, sats, signals, first_code, reference, report):
     if gap > 0:
         report["notes"].append(f"{gap} satellite-epoch(s) with code outside every broadcast record's validity")
     iono = {k: sky.klobuchar(k) for k in used_sys if sky.klobuchar(k) is not None}
-    return pos, clk, gd, iono
+    channels = {sid: int(k) for sid, k in zip(sky.sat_ids, sky.channels) if sid[0] == "R"}
+    return pos, clk, gd, iono, channels
+
+
+def _sat_frequencies(sats, signals, header_channels: dict, nav_channels: dict, report) -> np.ndarray:
+    """Carrier frequency (S, G) Hz of each satellite and signal: the signal's own, and for an FDMA (GLONASS)
+    signal that of the satellite's frequency number, from the header's 'GLONASS SLOT / FRQ #' or else from its
+    navigation records (NaN, and a note, where neither gives one)."""
+    out = np.empty((len(sats), len(signals)))
+    unknown = []
+    for j, name in enumerate(signals):
+        g = sigmod.get(name)
+        for i, sat in enumerate(sats):
+            if not g.is_fdma:
+                out[i, j] = g.freq_hz
+                continue
+            k = header_channels.get(sat, nav_channels.get(sat))
+            out[i, j] = np.nan if k is None else float(g.frequency_for(k))
+            if k is None and sat not in unknown:
+                unknown.append(sat)
+    if unknown:
+        report["notes"].append(f"no GLONASS frequency number (header 'GLONASS SLOT / FRQ #' or navigation record) "
+                               f"for {' '.join(unknown)}: their FDMA carrier frequencies are NaN")
+    return out
 
 
 def _state_of(const, t_w, t_s, sel):

@@ -36,11 +36,13 @@ DEFAULTS = {"cn0_zenith_dbhz": 45.0, "rolloff_db": 10.0, "dll_bandwidth_hz": 1.0
 
 
 def real_arrays(imported: importer.Imported) -> dict:
-    """{t, sat_id, signals, freq, obs {kind: {signal: (M, S)}}, sat_pos, reference} of an imported file."""
+    """{t, sat_id, signals, freq (G,) Hz, sat_freq (S, G) Hz, obs {kind: {signal: (M, S)}}, sat_pos, reference}
+    of an imported file."""
     d = imported.datasets
     signals = [str(s) for s in d["gnss/signals"]]
     return {"t": d["gnss/t"], "sat_id": [str(s) for s in d["gnss/sat_id"]], "signals": signals,
-            "freq": d["gnss/frequency_hz"], "sat_pos": d["gnss/sat_pos_ecef"],
+            "freq": d["gnss/frequency_hz"], "sat_freq": d.get("gnss/sat_frequency_hz", d["gnss/frequency_hz"]),
+            "sat_pos": d["gnss/sat_pos_ecef"],
             "obs": {k: {s: d[f"gnss/obs/{s}/{k}"][:, 0] for s in signals} for k in KINDS},
             "reference": d.get("reference/pos_ecef"), "start": (int(imported.attrs["start_gps_week"]),
                                                                  float(imported.attrs["start_gps_sow"])),
@@ -56,7 +58,8 @@ def file_arrays(path) -> dict:
     with open_dataset(path) as ds:
         g = read_gnss(ds, antennas=0, obs=KINDS)
         return {"t": g.t, "sat_id": [str(s) for s in g.sat_id], "signals": list(g.signals),
-                "freq": C_LIGHT / g.wavelength_m, "sat_pos": g.sat_pos_ecef, "obs": g.obs, "reference": None,
+                "freq": C_LIGHT / g.wavelength_m, "sat_freq": C_LIGHT / g.sat_wavelength_m, "sat_pos": g.sat_pos_ecef,
+                "obs": g.obs, "reference": None,
                 "sat_clock": g.sat_clock, "group_delay": g.group_delay,
                 "start": (int(ds.attrs["start_gps_week"]), float(ds.attrs["start_gps_sow"]))}
 
@@ -118,11 +121,11 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
 
 def statistics(arr: dict, el: np.ndarray) -> dict:
     """The per-file statistics of :mod:`.fidelity` over elevation bins (``el`` (M, S) rad for its columns)."""
-    obs, signals, freq, t = arr["obs"], arr["signals"], np.asarray(arr["freq"]), arr["t"]
+    obs, signals, freq, t = arr["obs"], arr["signals"], np.asarray(arr["sat_freq"]), arr["t"]
     on = fidelity.tracked(obs)
     mp = fidelity.multipath(obs, signals, freq, t)
     cn = fidelity.carrier_noise(obs, signals, freq, t)
-    dop = fidelity.doppler_residual(obs, signals, freq, t)
+    dop = fidelity.doppler_residual(obs, signals, t)
     return {
         "tracked_per_epoch": {"mean": float(on.sum(1).mean()), "min": int(on.sum(1).min()),
                               "max": int(on.sum(1).max())},
@@ -163,8 +166,11 @@ def on_twin_grid(real: dict, twin: dict) -> dict:
             src = real["obs"][kind][sig][rows[keep_r]][:, keep_c]
             a[np.ix_(np.flatnonzero(keep_r), cols[keep_c])] = src
             obs[kind][sig] = a
+    real_freq = np.broadcast_to(np.asarray(real["sat_freq"], float), (len(real["sat_id"]), len(real["signals"])))
+    sat_freq = np.full((s, len(real["signals"])), np.nan)
+    sat_freq[cols[keep_c]] = real_freq[keep_c]
     return {**real, "t": twin["t"], "sat_id": twin["sat_id"], "obs": obs, "sat_pos": twin["sat_pos"],
-            "sat_clock": twin.get("sat_clock"),
+            "sat_clock": twin.get("sat_clock"), "sat_freq": sat_freq,
             "not_in_twin": [real["sat_id"][i] for i in np.flatnonzero(~keep_c)]}
 
 
@@ -243,9 +249,8 @@ def fit_parameters(real: dict, reference) -> dict:
         notes.append("too few code-minus-carrier bins: code noise and multipath left at the defaults")
     else:
         p["mp_code_sigma_m"], p["mp_elevation_scale_deg"], p["code_error_scale"] = code
-    # the median over signals: a few metre-level series (GLONASS, formed with nominal frequencies) would rule a
-    # pooled estimate
-    rhos = [noise_fit.lag_one(v) for s, v in st["_series"]["mp"].items() if not sigmod.get(s).is_fdma]
+    # the median over signals: one signal's outlying series would rule a pooled estimate
+    rhos = [noise_fit.lag_one(v) for v in st["_series"]["mp"].values()]
     rhos = [r for r in rhos if r is not None]
     rho = float(np.median(rhos)) if rhos else None
     if rho is not None and 0.0 < rho < 1.0:
@@ -472,9 +477,8 @@ def noise_check(real_grid: dict, twins: list, ref, mask: float, rows=None) -> di
         real_grid, twins = _rows(real_grid, rows), [_rows(t, rows) for t in twins]
     el = fidelity.elevations(twins[0]["sat_pos"], ref)
 
-    def mp(a):   # FDMA (GLONASS): an imported file carries each signal's nominal frequency only, no channel
-        out = fidelity.multipath(a["obs"], a["signals"], np.asarray(a["freq"]), a["t"])
-        return {s: v for s, v in out.items() if not sigmod.get(s).is_fdma}
+    def mp(a):
+        return fidelity.multipath(a["obs"], a["signals"], np.asarray(a["sat_freq"]), a["t"])
 
     code = noise_fit.code_comparison(mp(real_grid), [mp(t) for t in twins], el, mask)
     cn0 = noise_fit.cn0_comparison(real_grid["obs"]["cn0"], [t["obs"]["cn0"] for t in twins], el,
@@ -618,7 +622,7 @@ def _holdout(real, ref, nav_paths, mask, seed, path, progress, split="half", cod
 def _with_drift(check: dict, other: dict, ref) -> dict:
     """``check`` (a :func:`noise_check` on some epochs) with the real file's own drift against the ``other``
     epochs (:func:`.noise_fit.drift`)."""
-    mp = fidelity.multipath(other["obs"], other["signals"], np.asarray(other["freq"]), other["t"])
+    mp = fidelity.multipath(other["obs"], other["signals"], np.asarray(other["sat_freq"]), other["t"])
     el = fidelity.elevations(other["sat_pos"], ref)
     check["code_noise"]["real_drift"] = noise_fit.drift(check["code_noise"]["signals"], mp, el)
     return check
