@@ -8,10 +8,10 @@ exactly the AR(1) recursion
 for any dt (no small-step approximation); sqrt(1 - phi^2) is computed as sqrt(-expm1(-2 dt / tau)), which
 keeps full precision when dt << tau. A process (re)started from its stationary distribution takes x_k = sigma w_k.
 
-One :class:`GaussMarkov` bank serves the IMU (bias terms, three axes, started stationary from their own random
-stream) and the GNSS multipath (one process per antenna, satellite, signal and observable, restarted at each
-acquisition). The recursion runs sample by sample in compiled code, so cutting a record into blocks in any way
-gives bit-identical values.
+A :class:`GaussMarkov` bank serves the GNSS multipath (one process per antenna, satellite, signal and observable,
+restarted at each acquisition; a correlation time per signal); the IMU's Gauss-Markov bias takes the coefficients
+of :func:`ar1_coefficients`. The recursion runs sample by sample in compiled code, so cutting a record into blocks
+in any way gives bit-identical values.
 """
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def ar1_coefficients(sigma: float, tau_s: float, dt_s: float) -> tuple[float, fl
 
 @numba.njit(cache=True, nogil=True)
 def _ar1_kernel(w, restart, phi, drive, sigma, state, out):  # pragma: no cover - compiled
-    """out[k, i] = sigma w[k, i] where restart[k, i], else phi out[k-1, i] + drive w[k, i]; state[i] carries
+    """out[k, i] = sigma w[k, i] where restart[k, i], else phi[i] out[k-1, i] + drive[i] w[k, i]; state[i] carries
     out[-1, i] between calls. ``restart`` of shape (0, 0) means "never restart"."""
     m, n = w.shape
     restarts = restart.shape[0] > 0
@@ -41,7 +41,7 @@ def _ar1_kernel(w, restart, phi, drive, sigma, state, out):  # pragma: no cover 
             if restarts and restart[k, i]:
                 x = sigma * w[k, i]
             else:
-                x = phi * state[i] + drive * w[k, i]
+                x = phi[i] * state[i] + drive[i] * w[k, i]
             state[i] = x
             out[k, i] = x
 
@@ -50,16 +50,19 @@ _NO_RESTART = np.zeros((0, 0), dtype=np.bool_)
 
 
 class GaussMarkov:
-    """A bank of independent first-order Gauss-Markov processes of one (sigma, tau_s), sampled every dt_s.
+    """A bank of independent first-order Gauss-Markov processes of one sigma, sampled every dt_s, with correlation
+    times ``tau_s``: one number, or an array broadcastable to the bank's ``shape`` (a time per process).
 
     ``shape`` is the shape of the bank (e.g. ``(3,)`` for three axes). With ``rng`` the processes start from their
     stationary distribution drawn from it and :meth:`block` draws the driving noise from it too; without ``rng``
     the state starts at zero and the caller supplies the noise and the restarts to :meth:`advance`.
     """
 
-    def __init__(self, sigma: float, tau_s: float, dt_s: float, shape: tuple, rng: np.random.Generator | None = None):
+    def __init__(self, sigma: float, tau_s, dt_s: float, shape: tuple, rng: np.random.Generator | None = None):
         self.sigma = float(sigma)
-        self.phi, self.drive = ar1_coefficients(self.sigma, tau_s, dt_s)
+        values, inverse = np.unique(np.broadcast_to(np.asarray(tau_s, dtype=float), shape), return_inverse=True)
+        coef = np.array([ar1_coefficients(self.sigma, t, dt_s) for t in values]).reshape(-1, 2)
+        self.phi, self.drive = (coef[:, k][inverse].reshape(shape) for k in (0, 1))   # (shape) each
         self.rng = rng
         self.state = self.sigma * rng.standard_normal(shape) if rng is not None else np.zeros(shape)
 
@@ -81,8 +84,9 @@ class GaussMarkov:
             r = r.reshape(r.shape + (1,) * (w.ndim - r.ndim))
             flags = np.ascontiguousarray(np.broadcast_to(r, w.shape)).reshape(m, -1)
         x = sel.reshape(-1).copy()
+        phi, drive = (np.ascontiguousarray(a[index]).reshape(-1) for a in (self.phi, self.drive))
         out = np.empty_like(flat_w)
-        _ar1_kernel(flat_w, flags, self.phi, self.drive, self.sigma, x, out)
+        _ar1_kernel(flat_w, flags, phi, drive, self.sigma, x, out)
         self.state[index] = x.reshape(sel.shape)
         return out.reshape(w.shape)
 

@@ -260,3 +260,18 @@ def test_static_output_carries_the_broadcast_klobuchar_coefficients_used():
     assert st.iono_systems.tolist() == ["G", "C"]
     np.testing.assert_array_equal(st.iono_alpha, [alpha, atmosphere.DEFAULT_BDS_ALPHA])
     np.testing.assert_array_equal(st.iono_beta, [beta, atmosphere.DEFAULT_BDS_BETA])
+
+
+def test_each_signal_has_its_multipath_correlation_time():
+    """[gnss.multipath.signal_correlation_time_s]: the stored carrier multipath of L2W decorrelates over its own
+    5 s, L1C's and B1I's over the common 200 s (lag-one correlation of the unit process exp(-dt / tau))."""
+    sim = make({"multipath": {"correlation_time_s": 200.0, "signal_correlation_time_s": {"L2W": 5.0}}},
+               duration=600.0)
+    out = run(sim, blocks=3)
+    for sig, tau in (("L1C", 200.0), ("L2W", 5.0), ("B1I", 200.0)):
+        x = out[f"truth/{sig}/multipath_carrier"]
+        el = out["truth/elevation"]
+        u = x / (sim.cfg.multipath.carrier_sigma_m * np.exp(-np.maximum(el, 1e-3) / sim.cfg.multipath.elevation_scale_rad))
+        pair = np.isfinite(u[1:]) & np.isfinite(u[:-1])
+        r = np.sum(u[1:][pair] * u[:-1][pair]) / np.sqrt(np.sum(u[1:][pair] ** 2) * np.sum(u[:-1][pair] ** 2))
+        assert r == pytest.approx(np.exp(-1.0 / tau), abs=0.03), sig

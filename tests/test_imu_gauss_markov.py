@@ -26,7 +26,9 @@ def test_matches_scipy_lfilter_and_any_block_cut():
     w = np.random.default_rng(12).standard_normal((5000, 3))
     cuts = [0, 1, 2, 999, 1000, 4321, 5000]
     out = np.concatenate([bank.advance(w[a:b]) for a, b in zip(cuts[:-1], cuts[1:])])
-    ref, _ = signal.lfilter([bank.drive], [1.0, -bank.phi], w, axis=0, zi=bank.phi * x0[None, :])
+    phi, drive = ar1_coefficients(0.3, 5.0, 0.02)
+    assert np.all(bank.phi == phi) and np.all(bank.drive == drive)
+    ref, _ = signal.lfilter([drive], [1.0, -phi], w, axis=0, zi=phi * x0[None, :])
     np.testing.assert_allclose(out, ref, rtol=1e-12, atol=1e-15)
     one = GaussMarkov(0.3, 5.0, 0.02, (3,), np.random.default_rng(11)).advance(w)
     np.testing.assert_array_equal(out, one)
@@ -56,8 +58,26 @@ def test_restart_and_index_select_part_of_the_bank():
     x = bank.advance(w, restart, index=(slice(None), cols))
     np.testing.assert_array_equal(x[0], w[0])
     np.testing.assert_array_equal(x[4, 1, 0], w[4, 1, 0])
-    np.testing.assert_allclose(x[4, 0, 0], bank.phi * x[3, 0, 0] + bank.drive * w[4, 0, 0], rtol=1e-15)
+    phi, drive = ar1_coefficients(1.0, 10.0, 1.0)
+    np.testing.assert_allclose(x[4, 0, 0], phi * x[3, 0, 0] + drive * w[4, 0, 0], rtol=1e-15)
     np.testing.assert_array_equal(bank.state[:, cols], x[-1])
     assert not bank.state[:, [0, 2]].any()                  # unselected processes untouched
     with pytest.raises(ValueError, match="shape"):
         bank.advance(w[:, :, :1], restart, index=(slice(None), cols))
+
+
+def test_a_correlation_time_per_signal():
+    """tau per signal (broadcast along the last axis): each signal's processes follow their own exact AR(1)
+    recursion, the lag correlation exp(-lag dt / tau) of each."""
+    taus = np.array([2.0, 20.0])
+    bank = GaussMarkov(1.0, taus[None, None, :], 1.0, (2, 300, 2))
+    w = np.random.default_rng(8).standard_normal((4000, 2, 300, 2))
+    restart = np.zeros((4000, 2, 300), bool)
+    restart[0] = True
+    x = bank.advance(w, restart)
+    for j, tau in enumerate(taus):
+        phi, drive = ar1_coefficients(1.0, tau, 1.0)
+        np.testing.assert_allclose(x[7, :, :, j], phi * x[6, :, :, j] + drive * w[7, :, :, j], rtol=1e-14)
+        y = x[:, :, :, j]
+        r = np.mean(y[1:] * y[:-1]) / np.mean(y * y)
+        assert r == pytest.approx(math.exp(-1.0 / tau), abs=0.01)

@@ -186,7 +186,7 @@ def test_the_fitted_fragment_is_a_valid_gnss_section(tmp_path):
     """The fragment merged into the twin's scenario loads (every key known, every value in range)."""
     from simkit.scenario import load
 
-    p = dict(twin.DEFAULTS, code_error_scale={"L1C": 0.2})
+    p = dict(twin.DEFAULTS, code_error_scale={"L1C": 0.2}, mp_signal_correlation_time_s={"L1C": 12.5})
     fragment = tomllib.loads(twin.toml_fragment(p))
     real = {"t": np.arange(20) * 30.0, "signals": ["L1C"], "start": (2213, 295200.0)}
     sc = twin.scenario(real, np.array([3516213.438, 781859.8595, 5246037.966]), [str(KMS3_NAV)], 5.0, {}, 1)
@@ -194,6 +194,7 @@ def test_the_fitted_fragment_is_a_valid_gnss_section(tmp_path):
     sc["gnss"]["antenna"] = fragment["gnss"]["antenna"]
     loaded = load(sc)
     assert loaded.gnss.code_error_scale == {"L1C": 0.2}
+    assert loaded.gnss.multipath.signal_correlation_time_s == {"L1C": 12.5}
     tables = {"L1C": ((5.0, 45.0), (2.0, 1.0)), "L2W": 0.5}
     fragment = tomllib.loads(twin.toml_fragment(dict(twin.DEFAULTS, code_error_scale=tables)))
     sc["gnss"]["code_error_scale"] = fragment["gnss"]["code_error_scale"]

@@ -47,6 +47,7 @@ class MultipathConfig:
     carrier_sigma_m: float       # at the horizon
     elevation_scale_rad: float
     correlation_time_s: float
+    signal_correlation_time_s: dict = field(default_factory=dict)   # signal -> s, where not correlation_time_s
 
 
 @dataclass(frozen=True)
@@ -127,7 +128,7 @@ def parse_config(sec: Section) -> GnssConfig:
         rate_hz=rate, elevation_mask_rad=np.radians(mask), sources=tuple(sources), antennas=tuple(antennas),
         signals=tuple(sigs), clock_mode=clock_mode, oscillator=clock.PRESETS[osc_name], oscillator_name=osc_name,
         errors=errors, cn0_zenith_dbhz=sec.get("cn0_zenith_dbhz", float, 45.0, check=in_range(10.0, 70.0)),
-        noise=_noise(sec.section("noise")), multipath=_multipath(sec.section("multipath")),
+        noise=_noise(sec.section("noise")), multipath=_multipath(sec.section("multipath"), sigs),
         slip_rate_per_h=sec.get("slip_rate_per_h", float, 0.0, check=non_negative),
         slips=tuple(_slip(s, sigs, len(antennas)) for s in _each(sec.sections("slip"))),
         outages=tuple(_outage(o, len(antennas)) for o in _each(sec.sections("outage"))),
@@ -201,12 +202,18 @@ def _noise(nz: Section) -> NoiseConfig:
     return cfg
 
 
-def _multipath(mp: Section) -> MultipathConfig:
+def _multipath(mp: Section, sigs: list[str]) -> MultipathConfig:
+    """[gnss.multipath], and [gnss.multipath.signal_correlation_time_s]: signal name -> correlation time (s) of
+    that signal's multipath, where it differs from ``correlation_time_s`` (``simkit twin --fit`` estimates them)."""
+    per = mp.section("signal_correlation_time_s")
+    times = {name: per.get(name, float, None, check=positive) for name in sigs}
+    per.done()
     cfg = MultipathConfig(
         code_sigma_m=mp.get("code_sigma_m", float, 1.0, check=non_negative),
         carrier_sigma_m=mp.get("carrier_sigma_m", float, 0.01, check=non_negative),
         elevation_scale_rad=np.radians(mp.get("elevation_scale_deg", float, 20.0, check=positive)),
-        correlation_time_s=mp.get("correlation_time_s", float, 30.0, check=positive))
+        correlation_time_s=mp.get("correlation_time_s", float, 30.0, check=positive),
+        signal_correlation_time_s={k: v for k, v in times.items() if v is not None})
     mp.done()
     return cfg
 

@@ -18,8 +18,9 @@ def elevation_scale(el, sigma_horizon, el0_rad):
     return sigma_horizon * np.exp(-np.asarray(el) / el0_rad)
 
 
-def multipath_bank(dt_s: float, tau_s: float, shape: tuple) -> GaussMarkov:
-    """The unit-variance bank of shape (A, S, G, 2) [antenna, satellite, signal, code/carrier].
+def multipath_bank(dt_s: float, tau_s, shape: tuple) -> GaussMarkov:
+    """The unit-variance bank of shape (A, S, G, 2) [antenna, satellite, signal, code/carrier], correlation times
+    ``tau_s`` s (a number, or broadcastable to ``shape``: (G, 1) one per signal).
 
     Advance the visible satellites ``cols`` with ``bank.advance(w, restart, index=(slice(None), cols))``:
     ``w`` (M, A, C, G, 2) standard normals, ``restart`` (M, A, C) True at each (re)acquisition.

@@ -108,7 +108,8 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                                       if isinstance(v, tuple) else v for k, v in p.get("code_error_scale", {}).items()},
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
-                               "correlation_time_s": p["mp_correlation_time_s"]},
+                               "correlation_time_s": p["mp_correlation_time_s"],
+                               "signal_correlation_time_s": dict(p.get("mp_signal_correlation_time_s", {}))},
                  **({"truth_errors": {**({"iono_residual_fraction": p["iono_residual_fraction"]}
                                          if p.get("iono_residual_fraction") is not None else {}),
                                       **p.get("truth_errors", {})}}
@@ -249,12 +250,14 @@ def fit_parameters(real: dict, reference) -> dict:
         notes.append("too few code-minus-carrier bins: code noise and multipath left at the defaults")
     else:
         p["mp_code_sigma_m"], p["mp_elevation_scale_deg"], p["code_error_scale"] = code
-    # the median over signals: one signal's outlying series would rule a pooled estimate
-    rhos = [noise_fit.lag_one(v) for v in st["_series"]["mp"].values()]
-    rhos = [r for r in rhos if r is not None]
-    rho = float(np.median(rhos)) if rhos else None
-    if rho is not None and 0.0 < rho < 1.0:
-        p["mp_correlation_time_s"] = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0))
+    # a correlation time per signal from its lag-one autocorrelation (a non-positive one: shorter than the interval,
+    # the floor dt / 5), the median over signals for the others: one signal's series would rule a pooled estimate
+    rhos = {s: noise_fit.lag_one(v) for s, v in st["_series"]["mp"].items()}
+    taus = {s: float(np.clip(-dt / np.log(r), dt / 5.0, 3600.0)) if r > 0.0 else dt / 5.0
+            for s, r in rhos.items() if r is not None and r < 1.0}
+    if taus:
+        p["mp_correlation_time_s"] = float(np.median(list(taus.values())))
+        p["mp_signal_correlation_time_s"] = taus
     rates = [v for v in st["slips_per_hour"].values() if v is not None]
     p["slip_rate_per_h"] = float(np.mean(rates)) if rates else 0.0
     if real.get("group_delay") is not None and real.get("iono"):
@@ -407,6 +410,8 @@ def toml_fragment(p: dict) -> str:
              f"carrier_sigma_m = {p['mp_carrier_sigma_m']:.5f}",
              f"elevation_scale_deg = {p['mp_elevation_scale_deg']:.2f}",
              f"correlation_time_s = {p['mp_correlation_time_s']:.1f}", "",
+             "# each signal's multipath correlation time (s)", "[gnss.multipath.signal_correlation_time_s]",
+             *(f"{k} = {v:.1f}" for k, v in p.get("mp_signal_correlation_time_s", {}).items()), "",
              "[gnss.code_error_scale]", *(f"{k} = {_scale_toml(v)}" for k, v in p.get("code_error_scale", {}).items()),
              "", "# the receiver's C/N0 per signal beyond the signal table's offsets",
              "[gnss.cn0_offset_db]", *(f"{k} = {v:.2f}" for k, v in p.get("cn0_offset_db", {}).items()),
