@@ -7,7 +7,8 @@ import numpy as np
 
 from ..frames import ecef_to_lla, quat_from_euler
 from ..io import n_antennas
-from .adapter import solved_attitude
+from ..earth import OMEGA_E
+from .adapter import filter_config, solved_attitude
 from .align import motion_alignment, static_alignment
 from .errors import EstimatorInputError
 from .inputs import GnssFixes, ImuData, InitialState
@@ -32,6 +33,17 @@ def _attitude_alignment(ds, p, gnss: GnssFixes, good, stop_s: float | None = Non
         raise EstimatorInputError("estimator.align: 'attitude' found no epoch with fixed ambiguities and a GNSS fix")
     g0 = good[both[0]]
     return att.euler[np.argmin(np.abs(att.t - gnss.t[g0]))], g0
+
+
+def gyrocompass_sigma(ds, p, lat: float) -> float:
+    """Heading uncertainty (rad, 1 sigma) of gyrocompassing over ``align_static_s`` at latitude ``lat`` rad with the
+    filter's gyro model (its initial bias sigma, and the angle random walk averaged over the span): the bias and the
+    noise read as a tilt of the horizontal Earth rate, Omega_e cos(lat) ~ 15 deg/h cos(lat). A MEMS gyro's bias of
+    tens to hundreds of deg/h leaves the heading undetermined (tens of degrees or more); a navigation-grade one,
+    well under a degree."""
+    cfg = filter_config(ds, p, None)
+    noise = np.hypot(cfg.p0_gyro_bias, cfg.gyro_arw / np.sqrt(max(float(p["align_static_s"]), 1e-3)))
+    return float(np.arctan2(noise, OMEGA_E * np.cos(lat)))
 
 
 def _static_start(p, imu: ImuData, lla_ant):
@@ -96,8 +108,11 @@ def stationary_start(p, imu: ImuData, gnss: GnssFixes) -> bool:
 def resolve_align(ds, p, imu: ImuData, gnss: GnssFixes):
     """(``p['align']`` with "auto" resolved, the attitude alignment found or None): "attitude" when the file has
     3+ antennas and the attitude solver fixes an epoch with a GNSS fix in the first AUTO_ATTITUDE_S, else
-    "static" when the start is stationary (:func:`stationary_start`), else "motion" when some GNSS fix is faster
-    than MOTION_SPEED_M_S, else "static" (levelling is all that is left on a slow platform)."""
+    "static" when the start is stationary (:func:`stationary_start`) and the gyros can find north in it
+    (:func:`gyrocompass_sigma` within the filter's initial heading sigma, ``p0_att_deg[2]``), else "motion" when
+    some GNSS fix is faster than MOTION_SPEED_M_S, else "static" (levelling is all that is left on a slow
+    platform; :func:`static_heading_sigma_deg` then widens the initial heading sigma to what gyrocompassing
+    gives)."""
     if p["align"] != "auto":
         return p["align"], None
     good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
@@ -106,10 +121,25 @@ def resolve_align(ds, p, imu: ImuData, gnss: GnssFixes):
             return "attitude", _attitude_alignment(ds, p, gnss, good, float(gnss.t[good[0]]) + AUTO_ATTITUDE_S)
         except EstimatorInputError:
             pass
-    if stationary_start(p, imu, gnss):
-        return "static", None
     fast = np.hypot(gnss.vel_enu[good, 0], gnss.vel_enu[good, 1]) > MOTION_SPEED_M_S
+    if stationary_start(p, imu, gnss) and good.size:
+        lat = ecef_to_lla(gnss.pos_ecef[good[0]])[0]
+        heading_p0 = np.radians(np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3)[2])
+        if gyrocompass_sigma(ds, p, lat) <= heading_p0 or not fast.any():
+            return "static", None
     return ("motion" if fast.any() else "static"), None
+
+
+def static_heading_sigma_deg(ds, p, gnss: GnssFixes) -> list[float]:
+    """``p['p0_att_deg']`` for a static alignment: the heading sigma widened to :func:`gyrocompass_sigma` where
+    that is larger (capped at 180 deg: a MEMS gyro finds no north, and a filter told 10 deg would trust a heading
+    that is anywhere)."""
+    p0 = [float(x) for x in np.broadcast_to(np.asarray(p["p0_att_deg"], float), 3)]
+    good = np.flatnonzero(np.isfinite(gnss.pos_ecef).all(1))
+    if good.size:
+        lat = ecef_to_lla(gnss.pos_ecef[good[0]])[0]
+        p0[2] = max(p0[2], min(180.0, float(np.degrees(gyrocompass_sigma(ds, p, lat)))))
+    return p0
 
 
 def attitude_source(ds, p) -> str:

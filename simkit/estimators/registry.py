@@ -12,7 +12,7 @@ import numpy as np
 from ..params import merge
 from ..solution import Solution, warn_truth
 from .adapter import attitude_fixes, broadcast_ionosphere, dd_carrier, filter_config, gnss_fixes, imu_data, spp_fixes
-from .align_policy import attitude_source, initial_state, resolve_align
+from .align_policy import attitude_source, initial_state, resolve_align, static_heading_sigma_deg
 from .errors import EstimatorInputError
 from .filters import HInfinityFilter, KalmanFilter15, KalmanFilter15DD, KalmanFilter21
 from .truth_inputs import TRUTH_KEYS, truth_inputs
@@ -67,6 +67,8 @@ def solve_filter(name):
         warn_truth(name, truth, TRUTH_KEYS)
         imu, gnss = imu_data(ds), gnss_fixes(ds, p)
         align, found = resolve_align(ds, p, imu, gnss)
+        if align == "static":
+            p = {**p, "p0_att_deg": static_heading_sigma_deg(ds, p, gnss)}
         init = initial_state(ds, {**p, "align": align}, imu, gnss, found)
         att = attitude_fixes(ds, p, src) if src is not None else None
         dd = dd_carrier(ds, p) if name == "kf15_dd" else None
