@@ -123,7 +123,8 @@ class GnssSimulator:
         self.draws = KeyedNormals(seed, self.n_ant, self.sat_ids, sys_signals, len(self.signals))
         taus = [cfg.multipath.signal_correlation_time_s.get(g.name, cfg.multipath.correlation_time_s)
                 for g in self.signals]
-        self.mp = multipath_bank(self.dt, np.array(taus)[:, None], (self.n_ant, len(self.sat_ids), len(self.signals), 2))
+        self.mp = multipath_bank(self.dt, np.array(taus)[:, None],
+                                 (self.n_ant, len(self.sat_ids), len(self.signals), 2))
         self.tracking = Tracking(cfg, seed, self.sat_ids, self.n_ant)
         self.vis = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)
         self.acquisition = Acquisition(cfg.acquisition, self.n_ant, len(self.sat_ids))
