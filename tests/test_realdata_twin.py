@@ -147,7 +147,7 @@ def test_twin_of_kms3_with_fit(tmp_path, capsys):
     # their standard errors say; out of sample on both splits no more than sampling and a few bins beyond two
     # standard errors (KMS3's 9 minutes: no bin resolves 20 %, noted in docs/real_data.md)
     ins = fid["noise"]["in_sample"]["code_noise"]
-    assert ins["twin_realisations"] == 4 and "G1C" not in ins["signals"]        # GLONASS FDMA left out
+    assert ins["twin_realisations"] == 4 and {"G1C", "G2C"} <= set(ins["signals"])   # GLONASS: each k's frequency
     sm = ins["summary"]
     assert sm["bins"] >= 20 and sm["chi2_per_bin"] < 1.5 and 0.9 < sm["median_ratio"] < 1.1
     assert sm["within"] >= sm["expected_within_if_equal"] - 3
@@ -247,10 +247,11 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
         return np.sqrt(np.mean(np.square(list(fid[run]["cn0_rms_difference_dbhz"].values()))))
     assert set(fid["fitted"]["cn0_rms_difference_dbhz"]) == {"L1C", "G1C"}
     assert rms("fitted") < 0.75 * rms("default")
-    # the noise checks: C/N0 of both systems with their standard errors, code noise of GPS only (FDMA left out)
+    # the noise checks: C/N0 and code noise of both systems with their standard errors (GLONASS with each
+    # satellite's frequency from the navigation records)
     for key in ("holdout", "holdout_interleaved"):
         n = fid[key]["noise"]
-        assert set(n["cn0"]) == {"L1C", "G1C"} and set(n["code_noise"]["signals"]) == {"L1C"}
+        assert set(n["cn0"]) == {"L1C", "G1C"} and set(n["code_noise"]["signals"]) == {"L1C", "G1C"}
         for c in n["cn0"].values():
             assert c["rms_dbhz"] ** 2 == pytest.approx(c["bias_dbhz"] ** 2 + c["scatter_dbhz"] ** 2)
             assert c["rms_se_dbhz"] > 0
