@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import datetime, timezone
 from pathlib import Path
@@ -37,6 +38,9 @@ CHUNK_ROWS = 1 << 16  # time samples per chunk along the first axis
 # saved cost to write; smooth truth (0.2-0.7) and constant terms (0.001) stay compressed.
 COMPRESS_MAX_RATIO = 0.8
 SKIP_FILTERS = 0b11  # filter mask of a raw chunk: shuffle and deflate skipped
+# Bytes of chunks queued for compression at most (bounds memory): about two blocks of a truth + IMU run, so the
+# caller goes on with the next block while the pool compresses this one instead of waiting for it.
+IN_FLIGHT_BYTES = 64 << 20
 
 
 def _chunks(shape, itemsize):
@@ -109,8 +113,8 @@ class Writer:
         self.attrs = attrs
         self.file: h5py.File | None = None
         self._series: dict[str, _Series] = {}
-        self._jobs: list = []
-        self._in_flight = 2 * (os.cpu_count() or 1)  # chunks being compressed at most (bounds memory)
+        self._jobs: deque = deque()  # (dataset, offset, job, filter mask or None, bytes held), in order
+        self._held = 0               # bytes of the chunks in self._jobs
         threads = compression_threads() if threads is None else threads
         self._pool = _Inline() if threads == 1 else ThreadPoolExecutor(max_workers=threads)
 
@@ -198,7 +202,7 @@ class Writer:
         rest = data[start:]
         series.pending = [rest.copy()] if len(rest) else []
         series.n_pending = len(rest)
-        self._drain(self._in_flight)
+        self._drain(IN_FLIGHT_BYTES)
 
     def _encode(self, series: _Series, chunk: np.ndarray, offset: tuple, own: bool) -> None:
         """Write the chunk raw now when the series' first chunk showed that deflating does not pay, else queue it
@@ -214,16 +218,18 @@ class Writer:
             chunk = chunk.copy()
         if series.raw is None:
             series.probe = self._pool.submit(_first_chunk, chunk)
-            self._jobs.append((series.ds, offset, series.probe, None))
-            return
-        self._jobs.append((series.ds, offset, self._pool.submit(_shuffle_deflate, chunk), 0))
+            self._jobs.append((series.ds, offset, series.probe, None, chunk.nbytes))
+        else:
+            self._jobs.append((series.ds, offset, self._pool.submit(_shuffle_deflate, chunk), 0, chunk.nbytes))
+        self._held += chunk.nbytes
 
     def _drain(self, keep: int) -> None:
-        """Write finished chunks in order, keeping at most ``keep`` in flight (bounds memory)."""
-        while len(self._jobs) > keep or (self._jobs and self._jobs[0][2].done()):
-            ds, offset, job, mask = self._jobs.pop(0)
+        """Write finished chunks in order, keeping at most ``keep`` bytes of chunks in flight (bounds memory)."""
+        while self._jobs and (self._held > keep or self._jobs[0][2].done()):
+            ds, offset, job, mask, held = self._jobs.popleft()
             data, mask = job.result() if mask is None else (job.result(), mask)  # None: a first chunk's job
             ds.id.write_direct_chunk(offset, data, filter_mask=mask)
+            self._held -= held
 
     def write(self, name: str, data, attrs: dict | None = None) -> None:
         """Write a whole (small, time-independent) dataset declared in :mod:`.schema`."""
