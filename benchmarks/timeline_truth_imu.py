@@ -52,7 +52,10 @@ simulator.ImuSimulator.process = timed("main", "imu", simulator.ImuSimulator.pro
 writer.Writer.append = timed("main", "append", writer.Writer.append)
 writer.Writer.__enter__ = timed("main", "open", writer.Writer.__enter__)
 writer.Writer.__exit__ = timed("main", "close", writer.Writer.__exit__)
-writer._shuffle_deflate = timed("pool", "deflate", writer._shuffle_deflate)
+if hasattr(writer, "shuffle_deflate"):
+    writer.shuffle_deflate = timed("pool", "deflate", writer.shuffle_deflate)
+else:  # the code before issue 25's third round
+    writer._shuffle_deflate = timed("pool", "deflate", writer._shuffle_deflate)
 writer._first_chunk = timed("pool", "first chunk", writer._first_chunk)
 c0 = time.process_time()
 
