@@ -89,15 +89,3 @@ def test_the_command_joins_a_thread_still_running_as_a_normal_exit_does(tmp_path
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0 and out.stdout.splitlines()[-1] == "thread done"
 
-
-def test_the_run_path_imports_no_pymap3d(tmp_path):
-    """pymap3d (and dateutil under it, ~10 ms of start-up) is imported where geodesy is asked for, not by a truth
-    + IMU run; simkit.earth.ELLIPSOID is still there for those who ask."""
-    scenario = truth_imu_toml(tmp_path, 1.0)
-    code = ("import sys\nfrom simkit.cli import main\n"
-            f"assert main(['run', {str(scenario)!r}, '-o', {str(tmp_path / 'o.h5')!r}, '-q']) == 0\n"
-            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('pymap3d', 'dateutil')))\n"
-            "from simkit import earth\nprint(earth.ELLIPSOID.semimajor_axis == earth.A)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.split("\n")[:2] == ["[]", "True"]
