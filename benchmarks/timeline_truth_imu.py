@@ -6,7 +6,9 @@ on its pool thread, the file's close) and prints, for each lane, its busy spans 
 of wall time from the process start, the idle gaps and the serial head (before the first truth block ends) and tail
 (after the last IMU block ends).
 
-    python benchmarks/timeline_truth_imu.py [--seconds 600] [--rate 1000] [--bins 40] [--json OUT]
+    python benchmarks/timeline_truth_imu.py [--seconds 600] [--rate 1000] [--bins 40] [--json OUT] [--tree DIR]
+
+``--tree``: the checkout to run (default this one; the code before issue 25's third round works too).
 """
 from __future__ import annotations
 
@@ -81,14 +83,14 @@ sys.exit(simkit.cli.console(sys.argv[1:]) if hasattr(simkit.cli, "console") else
 """
 
 
-def measure(seconds: float, rate: float) -> dict:
-    """One instrumented run: the child's spans with times in seconds from the parent's spawn."""
+def measure(seconds: float, rate: float, tree: Path = ROOT) -> dict:
+    """One instrumented run of ``tree``: the child's spans with times in seconds from the parent's spawn."""
     with tempfile.TemporaryDirectory(prefix="timeline_truth_imu_") as tmp:
         path = Path(tmp) / "s.toml"
         path.write_text(bench_truth_imu.scenario(seconds, rate))
         t0 = time.perf_counter()
         out = subprocess.run([sys.executable, "-c", PROBE, "run", str(path), "-o", str(Path(tmp) / "o.h5"), "-q"],
-                             cwd=ROOT, capture_output=True, text=True)
+                             cwd=tree, capture_output=True, text=True)
         t_exit = time.perf_counter() - t0
     if out.returncode != 0:
         raise RuntimeError(out.stderr[-2000:])
@@ -141,8 +143,9 @@ def main(argv=None) -> int:
     ap.add_argument("--rate", type=float, default=1000.0)
     ap.add_argument("--bins", type=int, default=40)
     ap.add_argument("--json", help="also write the spans as JSON to this file")
+    ap.add_argument("--tree", type=Path, default=ROOT, help="the checkout to run (default: this one)")
     args = ap.parse_args(argv)
-    r = measure(args.seconds, args.rate)
+    r = measure(args.seconds, args.rate, args.tree.resolve())
     report(r, args.bins)
     if args.json:
         Path(args.json).write_text(json.dumps(r, indent=1))
