@@ -42,7 +42,7 @@ def radii(lat, sin_lat=None):
     s2 = (np.sin(lat) if sin_lat is None else sin_lat) ** 2
     w = np.sqrt(1.0 - E2 * s2)
     rn = A / w
-    rm = A * (1.0 - E2) / w**3
+    rm = A * (1.0 - E2) / (w * w * w)  # not w**3: numpy's pow costs 6x two products (the truth calls this 8x a block)
     return rm, rn
 
 

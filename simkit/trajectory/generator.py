@@ -143,9 +143,10 @@ class Trajectory:
         roll = bank + rollx
         roll_dot = bank_dot + cmd["roll_rate"]
 
-        acc_enu = (cmd["accel"][:, None] * np.stack([cg * sp, cg * cp, sg], -1)
-                   + (speed * gamma_dot)[:, None] * np.stack([-sg * sp, -sg * cp, cg], -1)
-                   + (speed * psi_dot)[:, None] * np.stack([cg * cp, -cg * sp, np.zeros_like(t)], -1))
+        accel, v_gamma, v_psi = cmd["accel"], speed * gamma_dot, speed * psi_dot  # dv/dt = a u_v + V d(u_v)/dt
+        acc_enu = np.stack([accel * (cg * sp) + v_gamma * (-sg * sp) + v_psi * (cg * cp),
+                            accel * (cg * cp) + v_gamma * (-sg * cp) + v_psi * (-cg * sp),
+                            accel * sg + v_gamma * cg], -1)
 
         w_ie = earth.earth_rate_enu(lat, sin_lat, cos_lat)
         w_en = earth.transport_rate_enu(lat, hgt, vel_enu, sin_lat)
