@@ -14,6 +14,7 @@ more run, instrumented: start-up, imports, truth, IMU, writes, compression).
 
     python benchmarks/bench_truth_imu.py [--seconds 600] [--rate 1000] [--peer DIR] [--json OUT]
     python benchmarks/bench_truth_imu.py --ab OLD_TREE NEW_TREE [--rounds 3]     (before / after, no peer)
+    python benchmarks/bench_truth_imu.py --stages [--tree DIR]    (the truth and the IMU alone, one thread, no file)
 """
 from __future__ import annotations
 
@@ -180,6 +181,37 @@ print(f"{time.perf_counter() - t0:.2f} {r.ru_utime + r.ru_stime:.2f}")
 """
 
 
+STAGES = r"""
+import sys, time
+from simkit import pipeline
+from simkit.scenario import load
+sc = load(sys.argv[1], [])
+truth_cpu = imu_cpu = float("inf")
+for _ in range(3):
+    stages, t_truth, t_imu = pipeline.build(sc), 0.0, 0.0
+    blocks = stages.trajectory.blocks(block_samples=pipeline.BLOCK_SAMPLES)
+    while True:
+        c = time.thread_time()
+        truth = next(blocks, None)
+        t_truth += time.thread_time() - c
+        if truth is None:
+            break
+        c = time.thread_time()
+        stages.imu.process(truth.t, truth.omega_ib_b, truth.f_ib_b)
+        t_imu += time.thread_time() - c
+    truth_cpu, imu_cpu = min(truth_cpu, t_truth), min(imu_cpu, t_imu)
+print(f"truth {truth_cpu:.3f} s CPU, IMU {imu_cpu:.3f} s CPU (one thread, no file, best of 3)")
+"""
+
+
+def stages(tree: Path, seconds: float, rate: float) -> None:
+    """The truth and the IMU of the scenario alone in ``tree``'s code, on one thread (thread CPU, best of 3)."""
+    with tempfile.TemporaryDirectory(prefix="bench_truth_imu_stages_") as tmp:
+        path = Path(tmp) / "truth_imu.toml"
+        path.write_text(scenario(seconds, rate))
+        print(child([sys.executable, "-c", STAGES, str(path)], cwd=tree)[2].strip())
+
+
 def ab(trees, seconds: float, rate: float, rounds: int) -> None:
     """``python -m simkit run`` of the same scenario in each tree, alternating (timing.ab): wall and CPU s."""
     with tempfile.TemporaryDirectory(prefix="bench_truth_imu_ab_") as tmp:
@@ -244,7 +276,12 @@ def main(argv=None) -> int:
     ap.add_argument("--json", help="also write the figures as JSON to this file")
     ap.add_argument("--ab", nargs=2, metavar=("A", "B"), help="time two checkouts against each other instead")
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--stages", action="store_true", help="time the truth and the IMU alone instead")
+    ap.add_argument("--tree", type=Path, default=ROOT, help="with --stages: the checkout to time (default: this one)")
     args = ap.parse_args(argv)
+    if args.stages:
+        stages(args.tree.resolve(), args.seconds, args.rate)
+        return 0
     if args.ab:
         ab(args.ab, args.seconds, args.rate, args.rounds)
         return 0

@@ -10,7 +10,6 @@ contains the centrifugal part and acts along minus the ellipsoid normal. Truth a
 from __future__ import annotations
 
 import numpy as np
-import pymap3d
 
 A = 6378137.0                      # semi-major axis, m
 F = 1.0 / 298.257223563            # flattening
@@ -24,7 +23,17 @@ M_RATIO = OMEGA_E**2 * A**2 * B / GM  # 0.00344978650684
 C_LIGHT = 299792458.0              # m/s
 EARTH_RATE_ECEF = np.array([0.0, 0.0, OMEGA_E])  # w_ie^e, rad/s
 G0 = 9.80665                       # standard gravity, m/s^2: the unit behind "g", "mg", "ug" and load factors
-ELLIPSOID = pymap3d.Ellipsoid(A, B, name="WGS-84", model="wgs84")  # the same a and b, for pymap3d's geodesy
+
+
+def __getattr__(name):
+    """``ELLIPSOID``: the same a and b as a pymap3d ``Ellipsoid``, for pymap3d's geodesy (made on first use:
+    importing pymap3d costs a truth + IMU run ~10 ms of start-up it never needs)."""
+    if name == "ELLIPSOID":
+        import pymap3d
+
+        globals()["ELLIPSOID"] = pymap3d.Ellipsoid(A, B, name="WGS-84", model="wgs84")
+        return globals()["ELLIPSOID"]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def radii(lat, sin_lat=None):
@@ -33,7 +42,7 @@ def radii(lat, sin_lat=None):
     s2 = (np.sin(lat) if sin_lat is None else sin_lat) ** 2
     w = np.sqrt(1.0 - E2 * s2)
     rn = A / w
-    rm = A * (1.0 - E2) / w**3
+    rm = A * (1.0 - E2) / (w * w * w)  # not w**3: numpy's pow costs 6x two products (the truth calls this 8x a block)
     return rm, rn
 
 

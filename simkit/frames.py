@@ -10,7 +10,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-import pymap3d
 
 from . import earth
 
@@ -45,12 +44,16 @@ def skew(v) -> np.ndarray:
 
 def lla_to_ecef(lat, lon, h):
     """Geodetic (rad, rad, m) -> ECEF (..., 3) m."""
+    import pymap3d  # imported where used, like scipy.spatial: a truth + IMU run never needs it
+
     x, y, z = pymap3d.geodetic2ecef(lat, lon, h, ell=earth.ELLIPSOID, deg=False)
     return np.stack(np.broadcast_arrays(x, y, z), axis=-1).astype(float)
 
 
 def ecef_to_lla(pos):
     """ECEF (..., 3) m -> geodetic (..., 3): lat rad, lon rad, ellipsoidal height m."""
+    import pymap3d
+
     pos = np.asarray(pos, dtype=float)
     lat, lon, h = pymap3d.ecef2geodetic(pos[..., 0], pos[..., 1], pos[..., 2], ell=earth.ELLIPSOID, deg=False)
     return np.stack(np.broadcast_arrays(lat, lon, h), axis=-1).astype(float)

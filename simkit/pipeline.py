@@ -7,9 +7,10 @@ paths that ``simkit/io/schema.py`` declares.
 from __future__ import annotations
 
 import json
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, fields
 from pathlib import Path
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
@@ -28,6 +29,7 @@ if TYPE_CHECKING:  # the GNSS stages are imported when a scenario has [gnss]: a 
     from .gnss import GnssSimulator
 
 BLOCK_SAMPLES = 1 << 16
+TRUTH_AHEAD = 2  # truth blocks computed ahead of the IMU and the writes (12 MB each at 65,536 samples)
 GNSS_CELLS = 1 << 20  # ~8 MB per (M, A, S) float array handed from the GNSS stage to the writer
 MAX_OUTPUT_BYTES = 100 * 2**30  # refuse larger runs unless forced: a typo in duration_s, not a dataset
 _SKY_CHECK_STEP_S = 60.0
@@ -233,18 +235,22 @@ def _write_static(w: Writer, sc: Scenario, stages: Stages) -> None:
             w.write(path, data)
 
 
-def _truth_ahead(blocks: Iterator, ahead: bool) -> Iterator:
-    """The truth blocks, each computed on a worker thread while the caller processes the one before (numpy
-    releases the GIL in its loops, so the truth and the IMU + write share two cores); in order, as computed
-    alone. ``ahead`` False: on the calling thread."""
+def _truth_ahead(blocks: Iterator, ahead: bool, depth: int = TRUTH_AHEAD) -> Iterator:
+    """The truth blocks, computed on a worker thread up to ``depth`` blocks ahead of the caller (numpy releases the
+    GIL in its loops, so the truth, the IMU + writes and the compression share the cores; one block ahead left the
+    worker idle while the caller waited for the compression); in order, as computed alone. ``ahead`` False: on the
+    calling thread."""
     if not ahead:
         yield from blocks
         return
-    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="simkit-truth") as worker:
-        nxt = worker.submit(next, blocks, None)
-        while (block := nxt.result()) is not None:
-            nxt = worker.submit(next, blocks, None)
+    worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="simkit-truth")  # one thread: in order
+    try:
+        queued = deque(worker.submit(next, blocks, None) for _ in range(depth))
+        while (block := queued.popleft().result()) is not None:
+            queued.append(worker.submit(next, blocks, None))
             yield block
+    finally:
+        worker.shutdown(wait=True, cancel_futures=True)
 
 
 def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress: bool, ahead: bool = False) -> None:

@@ -66,8 +66,8 @@ def test_both_deflate_paths_decode_through_hdf5(tmp_path, hide_isal):
         "import sys\n"
         + ("sys.modules['isal'] = None\n" if hide_isal else "")
         + "import simkit, h5py, numpy as np\n"
-        "from simkit.io import writer\n"
-        "print(writer.deflate.__name__)\n"
+        "from simkit.io import shuffle_deflate\n"
+        "print(shuffle_deflate.deflate.__name__)\n"
         f"p = simkit.run('quickstart', out=r'{tmp_path / 'q.h5'}', overrides=['scenario.duration_s=700'])\n"
         "f = h5py.File(p, 'r'); d = f['truth/pos_ecef']\n"
         "assert d.compression == 'gzip' and d.chunks[0] < d.shape[0]\n"

@@ -28,16 +28,16 @@ def test_same_scenario_and_seed_give_identical_arrays(tmp_path):
         assert np.array_equal(xa[k], xb[k], equal_nan=xa[k].dtype.kind == "f"), k
 
 
-def test_truth_and_imu_run_imports_no_scipy_spatial_numba_or_skyfield(tmp_path):
+def test_truth_and_imu_run_imports_no_scipy_spatial_numba_skyfield_or_pymap3d(tmp_path):
     """The start-up of a truth + IMU run (the CLI parser of every verb included) stays light: none of those
-    modules (about 0.3 s of CPU together) is needed without [gnss]."""
+    modules (about 0.3 s of CPU together; pymap3d with dateutil ~10 ms) is needed without [gnss]."""
     from truth_imu_scenario import truth_imu_toml
 
     path = truth_imu_toml(tmp_path, 2.0)
     code = ("import sys\nfrom simkit.cli import main\n"
             f"assert main(['run', {str(path)!r}, '-o', {str(tmp_path / 'out.h5')!r}, '-q']) == 0\n"
             "print(sorted({m.split('.')[0] + ('.spatial' if m.startswith('scipy.spatial') else '') for m in sys.modules"
-            " if m.startswith(('scipy.spatial', 'numba', 'skyfield'))}))")
+            " if m.startswith(('scipy.spatial', 'numba', 'skyfield', 'pymap3d', 'dateutil'))}))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[]"

@@ -3,14 +3,15 @@ own reader decodes both exactly (a raw chunk carries the filter mask that skips 
 import h5py
 import numpy as np
 
-from simkit.io.writer import CHUNK_ROWS, COMPRESS_MAX_RATIO, SKIP_FILTERS, Writer, _shuffle_deflate
+from simkit.io.shuffle_deflate import shuffle_deflate
+from simkit.io.writer import CHUNK_ROWS, COMPRESS_MAX_RATIO, SKIP_FILTERS, Writer
 
 
 def test_noise_is_stored_raw_and_smooth_truth_compressed(tmp_path):
     n = 2 * CHUNK_ROWS + 1234
     noise = np.random.default_rng(0).standard_normal((n, 3))
     t = np.arange(n) / 1000.0
-    assert len(_shuffle_deflate(noise[:CHUNK_ROWS])) > COMPRESS_MAX_RATIO * noise[:CHUNK_ROWS].nbytes
+    assert len(shuffle_deflate(noise[:CHUNK_ROWS])) > COMPRESS_MAX_RATIO * noise[:CHUNK_ROWS].nbytes
     path = tmp_path / "w.h5"
     with Writer(path, {}, threads=2) as w:
         for a in range(0, n, 50_000):                      # blocks that do not align with chunks

@@ -1,10 +1,9 @@
 """Writing the simkit HDF5 file (schema v1: :mod:`.schema`, README "HDF5 layout"): chunked, gzip-compressed, appended in time blocks.
 
-Time series are compressed chunk by chunk in a thread pool (byte shuffle + deflate level 1 in zlib format, which
-is what HDF5's shuffle and deflate filters read, so any HDF5 reader decodes them) and stored with direct chunk
-writes. Deflate is ISA-L's (``isal``, the optional ``fast`` extra) when installed: the same format at about 13x
-zlib's speed; otherwise the standard library's ``zlib``. Both release the GIL, so compression runs beside the
-simulation. The file is written under a temporary name
+Time series are compressed chunk by chunk in a thread pool (byte shuffle + deflate in zlib format, which is what
+HDF5's shuffle and deflate filters read, so any HDF5 reader decodes them; the byte planes that do not compress are
+stored in the deflate stream as they are: :mod:`.shuffle_deflate`) and stored with direct chunk writes. Deflate
+releases the GIL, so compression runs beside the simulation. The file is written under a temporary name
 in the destination folder and renamed only when complete, so an interrupted run never leaves a truncated file
 under the output name.
 """
@@ -12,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import datetime, timezone
 from pathlib import Path
@@ -24,11 +24,7 @@ from ..errors import ScenarioError
 from ..version import __version__
 from . import schema
 from .schema import SCHEMA_VERSION
-
-try:  # ISA-L writes the same zlib format as the standard library, ~13x faster
-    from isal import isal_zlib as deflate
-except ImportError:  # pragma: no cover - exercised by the test that hides isal
-    import zlib as deflate
+from .shuffle_deflate import shuffle_deflate
 
 CHUNK_ROWS = 1 << 16  # time samples per chunk along the first axis
 # A series whose first chunk deflates to more than this fraction of its bytes is stored raw: its chunks skip the
@@ -37,6 +33,9 @@ CHUNK_ROWS = 1 << 16  # time samples per chunk along the first axis
 # saved cost to write; smooth truth (0.2-0.7) and constant terms (0.001) stay compressed.
 COMPRESS_MAX_RATIO = 0.8
 SKIP_FILTERS = 0b11  # filter mask of a raw chunk: shuffle and deflate skipped
+# Bytes of chunks queued for compression at most (bounds memory): about two blocks of a truth + IMU run, so the
+# caller goes on with the next block while the pool compresses this one instead of waiting for it.
+IN_FLIGHT_BYTES = 64 << 20
 
 
 def _chunks(shape, itemsize):
@@ -44,16 +43,10 @@ def _chunks(shape, itemsize):
     return (rows,) + tuple(shape[1:])
 
 
-def _shuffle_deflate(chunk: np.ndarray) -> bytes:
-    """The bytes HDF5's shuffle + deflate(level 1) filters make of one full chunk."""
-    raw = np.ascontiguousarray(chunk).view(np.uint8).reshape(-1, chunk.dtype.itemsize)
-    return deflate.compress(np.ascontiguousarray(raw.T), 1)  # a buffer: no bytes copy (it faults fresh pages)
-
-
-def _first_chunk(chunk: np.ndarray) -> tuple[bytes | np.ndarray, int]:
-    """(what to store, filter mask) of a series' first chunk: deflated, or raw when deflating it does not pay
-    (COMPRESS_MAX_RATIO); the series follows this choice."""
-    packed = _shuffle_deflate(chunk)
+def _first_chunk(chunk: np.ndarray, valid: int) -> tuple[bytes | np.ndarray, int]:
+    """(what to store, filter mask) of a series' first chunk (``valid`` rows before its padding): shuffled and
+    deflated, or raw when that does not pay (COMPRESS_MAX_RATIO); the series follows this choice."""
+    packed = shuffle_deflate(chunk, valid)
     return (chunk, SKIP_FILTERS) if len(packed) > COMPRESS_MAX_RATIO * chunk.nbytes else (packed, 0)
 
 
@@ -109,8 +102,8 @@ class Writer:
         self.attrs = attrs
         self.file: h5py.File | None = None
         self._series: dict[str, _Series] = {}
-        self._jobs: list = []
-        self._in_flight = 2 * (os.cpu_count() or 1)  # chunks being compressed at most (bounds memory)
+        self._jobs: deque = deque()  # (dataset, offset, job, filter mask or None, bytes held), in order
+        self._held = 0               # bytes of the chunks in self._jobs
         threads = compression_threads() if threads is None else threads
         self._pool = _Inline() if threads == 1 else ThreadPoolExecutor(max_workers=threads)
 
@@ -187,23 +180,25 @@ class Writer:
         start = 0
         while len(data) - start >= series.rows or (final and start < len(data)):
             chunk = data[start:start + series.rows]
-            if len(chunk) < series.rows:
+            valid = len(chunk)
+            if valid < series.rows:
                 chunk = np.concatenate([chunk, np.zeros((series.rows - len(chunk),) + chunk.shape[1:], chunk.dtype)])
             else:
                 chunk = np.ascontiguousarray(chunk)  # a view of a C-ordered block already is (no copy)
             offset = (series.n_chunks * series.rows,) + (0,) * (chunk.ndim - 1)
-            self._encode(series, chunk, offset, own or len(chunk) < series.rows)
+            self._encode(series, chunk, offset, own or valid < series.rows, valid)
             series.n_chunks += 1
             start += series.rows
         rest = data[start:]
         series.pending = [rest.copy()] if len(rest) else []
         series.n_pending = len(rest)
-        self._drain(self._in_flight)
+        self._drain(IN_FLIGHT_BYTES)
 
-    def _encode(self, series: _Series, chunk: np.ndarray, offset: tuple, own: bool) -> None:
+    def _encode(self, series: _Series, chunk: np.ndarray, offset: tuple, own: bool, valid: int) -> None:
         """Write the chunk raw now when the series' first chunk showed that deflating does not pay, else queue it
-        for compression in the pool (``own``: ``chunk`` is the writer's; otherwise the pool gets a copy). The
-        first chunk is tried in the pool too; the series waits for that answer only at its second chunk."""
+        for compression in the pool (``own``: ``chunk`` is the writer's; otherwise the pool gets a copy; ``valid``:
+        its rows before the zero padding of the last chunk). The first chunk is tried in the pool too; the series
+        waits for that answer only at its second chunk."""
         if series.raw is None and series.probe is not None:
             series.raw = series.probe.result()[1] == SKIP_FILTERS
             series.probe = None
@@ -213,17 +208,20 @@ class Writer:
         if not (own or isinstance(self._pool, _Inline)):
             chunk = chunk.copy()
         if series.raw is None:
-            series.probe = self._pool.submit(_first_chunk, chunk)
-            self._jobs.append((series.ds, offset, series.probe, None))
-            return
-        self._jobs.append((series.ds, offset, self._pool.submit(_shuffle_deflate, chunk), 0))
+            series.probe = self._pool.submit(_first_chunk, chunk, valid)
+            self._jobs.append((series.ds, offset, series.probe, None, chunk.nbytes))
+        else:
+            self._jobs.append((series.ds, offset, self._pool.submit(shuffle_deflate, chunk, valid), 0,
+                               chunk.nbytes))
+        self._held += chunk.nbytes
 
     def _drain(self, keep: int) -> None:
-        """Write finished chunks in order, keeping at most ``keep`` in flight (bounds memory)."""
-        while len(self._jobs) > keep or (self._jobs and self._jobs[0][2].done()):
-            ds, offset, job, mask = self._jobs.pop(0)
+        """Write finished chunks in order, keeping at most ``keep`` bytes of chunks in flight (bounds memory)."""
+        while self._jobs and (self._held > keep or self._jobs[0][2].done()):
+            ds, offset, job, mask, held = self._jobs.popleft()
             data, mask = job.result() if mask is None else (job.result(), mask)  # None: a first chunk's job
             ds.id.write_direct_chunk(offset, data, filter_mask=mask)
+            self._held -= held
 
     def write(self, name: str, data, attrs: dict | None = None) -> None:
         """Write a whole (small, time-independent) dataset declared in :mod:`.schema`."""

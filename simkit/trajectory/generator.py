@@ -22,7 +22,7 @@ import numpy as np
 from .. import earth, frames
 from ..earth import G0
 from .config import TrajectoryConfig
-from .truth import TrajectoryTruth, Trig, body_truth, trig
+from .truth import TrajectoryTruth, Trig, body_truth, sin_cos, trig
 
 CHANNELS = ("accel", "pitch_rate", "turn_rate", "turn_accel", "roll_rate")
 
@@ -108,19 +108,19 @@ class Trajectory:
 
         g_t, p_t = trig(gamma), trig(psi)            # at the nodes: shared with the attitude (half angles)
         ve, vn, vu = speed * g_t.cos * p_t.sin, speed * g_t.cos * p_t.cos, speed * g_t.sin
-        cg_m = np.cos(gamma_m)
-        ve_m, vn_m, vu_m = speed_m * cg_m * np.sin(psi_m), speed_m * cg_m * np.cos(psi_m), speed_m * np.sin(gamma_m)
+        (sg_m, cg_m), (sp_m, cp_m) = sin_cos(gamma_m), sin_cos(psi_m)
+        ve_m, vn_m, vu_m = speed_m * cg_m * sp_m, speed_m * cg_m * cp_m, speed_m * sg_m
         hgt, hgt_m = _cumulative(h0, vu, vu_m, h)
         rm, _ = earth.radii(lat0)    # the first pass from lat0 everywhere: one radius
         lat, lat_m = _cumulative(lat0, vn / (rm + hgt), vn_m / (rm + hgt_m), h)
         for _ in range(2):
-            rm, _ = earth.radii(lat)
-            rm_m, _ = earth.radii(lat_m)
+            rm, _ = earth.radii(lat, sin_cos(lat)[0])
+            rm_m, _ = earth.radii(lat_m, sin_cos(lat_m)[0])
             lat, lat_m = _cumulative(lat0, vn / (rm + hgt), vn_m / (rm_m + hgt_m), h)
-        sl, sl_m, cl = np.sin(lat), np.sin(lat_m), np.cos(lat)
+        (sl, cl), (sl_m, cl_m) = sin_cos(lat), sin_cos(lat_m)
         _, rn = earth.radii(lat, sl)
         _, rn_m = earth.radii(lat_m, sl_m)
-        lon, _ = _cumulative(lon0, ve / ((rn + hgt) * cl), ve_m / ((rn_m + hgt_m) * np.cos(lat_m)), h)
+        lon, _ = _cumulative(lon0, ve / ((rn + hgt) * cl), ve_m / ((rn_m + hgt_m) * cl_m), h)
 
         k = slice(skip, None)  # views: the truth is formed sample by sample
         truth = self._assemble(t[k], {name: v[k] for name, v in cn.items()}, speed[k],
@@ -143,9 +143,10 @@ class Trajectory:
         roll = bank + rollx
         roll_dot = bank_dot + cmd["roll_rate"]
 
-        acc_enu = (cmd["accel"][:, None] * np.stack([cg * sp, cg * cp, sg], -1)
-                   + (speed * gamma_dot)[:, None] * np.stack([-sg * sp, -sg * cp, cg], -1)
-                   + (speed * psi_dot)[:, None] * np.stack([cg * cp, -cg * sp, np.zeros_like(t)], -1))
+        accel, v_gamma, v_psi = cmd["accel"], speed * gamma_dot, speed * psi_dot  # dv/dt = a u_v + V d(u_v)/dt
+        acc_enu = np.stack([accel * (cg * sp) + v_gamma * (-sg * sp) + v_psi * (cg * cp),
+                            accel * (cg * cp) + v_gamma * (-sg * cp) + v_psi * (-cg * sp),
+                            accel * sg + v_gamma * cg], -1)
 
         w_ie = earth.earth_rate_enu(lat, sin_lat, cos_lat)
         w_en = earth.transport_rate_enu(lat, hgt, vel_enu, sin_lat)
@@ -155,6 +156,7 @@ class Trajectory:
 
         pos_lla = np.stack([lat, lon, hgt], axis=-1)
         r_cos = (rn + hgt) * cos_lat  # geodetic -> ECEF with the prime-vertical radius rn at hand
-        pos_ecef = np.stack([r_cos * np.cos(lon), r_cos * np.sin(lon), (rn * (1.0 - earth.E2) + hgt) * sin_lat], -1)
+        s_lon, c_lon = sin_cos(lon)
+        pos_ecef = np.stack([r_cos * c_lon, r_cos * s_lon, (rn * (1.0 - earth.E2) + hgt) * sin_lat], -1)
         return TrajectoryTruth(t=t, pos_ecef=pos_ecef, pos_lla=pos_lla, vel_enu=vel_enu,
                                quat_nb=quat_nb, euler=euler, omega_ib_b=omega_ib_b, f_ib_b=f_ib_b)
