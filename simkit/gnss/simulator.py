@@ -41,6 +41,7 @@ from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
 from .columns import place_columns
 from .orbit_range import range_errors
+from .shadowing import Shadowing
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
 from .tropo_truth import TruthTroposphere
@@ -102,6 +103,8 @@ class GnssSimulator:
         self.acquisition = Acquisition(cfg.acquisition, self.n_ant, len(self.sat_ids))
         self.nlos = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)   # tracking a reflection only
         self.sat_index = {sid: k for k, sid in enumerate(self.sat_ids)}
+        self.shadowing = None if cfg.shadowing is None else Shadowing(cfg.shadowing, seed, self.sat_ids,
+                                                                       self.n_ant, self.dt)
         self._truth_models(seed)
 
     def _truth_models(self, seed: int) -> None:
@@ -205,10 +208,18 @@ class GnssSimulator:
             los = self.env.classify(ant_pos, view.lla, view.vel_enu, view.los, view.azimuth, view.elevation,
                                     view.azimuth_rate, view.elevation_rate, c_be)
         vis_c, off = self._visibility(t, view, c_be, cand, los)
-        vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         k0 = int(round(t[0] * self.cfg.rate_hz))
+        shadow = None
+        if self.shadowing is not None:   # street shadowing (simkit.gnss.shadowing): a blocked satellite is not tracked
+            el_c = ref["elevation"][:, cand]
+            with np.errstate(invalid="ignore"):
+                shadow = self.shadowing.advance(k0, el_c, el_c >= low - _MASK_MARGIN_RAD,
+                                                np.linalg.norm(np.asarray(vel_ecef, float).reshape(t.size, 3), axis=1),
+                                                cand)
+            vis_c = vis_c & (shadow.state != 2)
+        vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
-        parts = _Parts(self, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los)
+        parts = _Parts(self, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los, shadow)
         return GnssEpochs(t=t, sat_pos_ecef=ref["sat_pos_emission"], sat_clock=ref["sat_clock"],
                           truth=parts.truth(ant_pos, ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
 
@@ -258,8 +269,9 @@ class GnssSimulator:
 class _Parts:
     """The error terms and observables of one block, computed step by step on the candidate columns."""
 
-    def __init__(self, sim: GnssSimulator, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los=None):
-        self.sim, self.cand, self.view, self.m, self.los = sim, cand, view, t.size, los
+    def __init__(self, sim: GnssSimulator, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los=None,
+                 shadow=None):
+        self.sim, self.cand, self.view, self.m, self.los, self.shadow = sim, cand, view, t.size, los, shadow
         self.t, self.week, self.sow = t, week, sow
         self.shape = (t.size, sim.n_ant, len(sim.sat_ids))
         err = sim.cfg.errors
@@ -396,6 +408,8 @@ class _Parts:
         for a, ant in enumerate(cfg.antennas):
             if ant.gain_pattern is not None:
                 cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern, cn0_off)
+        if self.shadow is not None:
+            cn0 = cn0 - self.shadow.attenuation_db[..., cj]
         freq = sim.freq[cols, j]                                                    # (C,) Hz
         lam = C_LIGHT / freq if g.is_fdma else g.wavelength_m
         sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g, lam))
@@ -476,4 +490,7 @@ class _Parts:
                          satellite_clock_error=self.sat_clk_error,
                          system_time_offset=self.sys_offset,
                          los_state=None if self.los is None else self.full(self.los.state, 255),
-                         nlos_delay=None if self.los is None else self.full(self.los.extra))
+                         nlos_delay=None if self.los is None else self.full(self.los.extra),
+                         shadow_state=None if self.shadow is None else self.full(self.shadow.state, 255),
+                         shadow_attenuation=None if self.shadow is None else self.full(
+                             np.where(self.shadow.state <= 1, self.shadow.attenuation_db, np.nan)))
