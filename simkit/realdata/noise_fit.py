@@ -243,6 +243,35 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
     return out
 
 
+def cn0_drift(bins: list, other_cn0, el_other) -> dict:
+    """The real file's C/N0 against itself: each compared bin of :func:`cn0_comparison` (``bins``, the checked
+    epochs) gets the real mean over the *other* epochs (``other_cn0`` (M', S) dB-Hz, elevations ``el_other`` rad,
+    e.g. the epochs a split fitted on; :func:`bin_mean`), and the differences checked - other over the bins are
+    summarised as the twin's are (bias, scatter, RMS, the RMS of their standard errors, chi-square per bin): the
+    RMS a perfect model of the receiver could not beat on these epochs, the environment having changed."""
+    el_deg = np.degrees(el_other)
+    between = satellite_spread(other_cn0, el_deg, [b["bin_deg"][0] for b in bins] + [bins[-1]["bin_deg"][1]]) \
+        if bins else None
+    diffs, ses = [], []
+    for b in bins:
+        if b["difference"] is None:
+            continue
+        o = bin_mean(other_cn0, el_deg, *b["bin_deg"])
+        if o["se"] is not None and between is not None:
+            o["se"] = max(o["se"], between / np.sqrt(o["satellites"]))
+        b["real_other_dbhz"] = o["mean"]
+        if o["mean"] is None or o["n"] < 10:
+            continue
+        diffs.append(b["real_dbhz"] - o["mean"])
+        ses.append(float(np.hypot(b["real_se"], o["se"])))
+    d, e = np.array(diffs), np.array(ses)
+    if not d.size:
+        return {"bins": 0}
+    return {"bins": int(d.size), "bias_dbhz": float(d.mean()), "scatter_dbhz": float(d.std()),
+            "rms_dbhz": float(np.sqrt(np.mean(d ** 2))), "rms_se_dbhz": float(np.sqrt(np.mean(e ** 2))),
+            "chi2_per_bin": float(np.mean((d / e) ** 2)) if (e > 0).all() else None}
+
+
 def drift(per_signal: dict, other_mp: dict, el_other, tol: float = TOLERANCE) -> dict:
     """The real file against itself: each bin of :func:`code_comparison`'s ``per_signal`` (the checked epochs)
     gets the real sigma over the *other* epochs (``other_mp`` {signal: (M', S)}, elevations ``el_other`` rad,

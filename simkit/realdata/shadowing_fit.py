@@ -1,0 +1,140 @@
+"""The street-shadowing channel of :mod:`simkit.gnss.shadowing` estimated from a real drive's C/N0 time series.
+
+Per satellite-epoch above the mask (the default twin's geometry) the real file either tracks the satellite or not
+(blocked); a tracked one's C/N0 less its signal's offset, y, is a mixture of a line-of-sight level L_b per
+10-degree elevation bin b with a spread s_los, and a shadowed one at L_b - A, A ~ N(mu, s_sh^2) (log-normal
+attenuation), the shadowed share w_b per bin. The mixture is fitted by expectation-maximisation (Dempster, Laird
+& Rubin 1977): responsibilities g of the shadowed component, then L_b from both components (weighted least
+squares), mu, the two spreads and w_b in closed form; 100 iterations from L_b = the bin's 90th percentile. Each
+satellite-epoch is then classified (shadowed where g > 1/2) and
+
+* the state probabilities per bin are the shares of line of sight, shadowed and blocked among the satellite-epochs
+  above the mask (a bin with fewer than ``MIN_COUNT`` takes the pooled shares);
+* the mean dwell of a state is its occupancy over its exits (epochs in the state followed by another state), times
+  the interval: the maximum-likelihood mean of exponential durations with the runs cut by the file's ends and the
+  satellites' rising and setting left censored, not counted as exits;
+* the attenuation's correlation time from the lag-one autocorrelation rho of the attenuation over consecutive
+  shadowed epochs, -dt / ln(rho);
+* the gain pattern (the line-of-sight C/N0 against elevation) from L_b: the twin's shadowing then takes the
+  shadowed epochs' loss off it, where the pattern fitted without the term is the bins' mean over clear and
+  shadowed epochs together.
+
+Dwell times are in seconds (the real file's epochs; a drive's speeds from an SPP path are too noisy for metres).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import fidelity
+
+MIN_COUNT = 30          # satellite-epochs above the mask for a bin's own state probabilities
+ITERATIONS = 100
+FLOOR_DB = 0.5          # the spreads' floor (a C/N0 quantised to 1 dB or noiseless in a simulated file)
+
+
+def _bins(el_deg, edges):
+    return np.clip(np.searchsorted(edges, el_deg, side="right") - 1, 0, len(edges) - 2)
+
+
+def _normal(r, mean, sd):
+    return np.exp(-0.5 * ((r - mean) / sd) ** 2) / sd
+
+
+def mixture(y, b, n_bins: int, iterations: int = ITERATIONS) -> dict:
+    """EM fit of the two-component model (module docstring) to C/N0 values ``y`` (n,) dB-Hz in bins ``b`` (n,) int:
+    {level (B,) (NaN for empty bins), los_sd, mean, sd (attenuation), share (B,), responsibility (n,)}."""
+    level = np.full(n_bins, np.nan)
+    for k in np.unique(b):
+        level[k] = np.quantile(y[b == k], 0.9)
+    los_sd, mu, sd = 1.5, 8.0, 4.0
+    share = np.full(n_bins, 0.4)
+    g = np.zeros(y.size)
+    for _ in range(iterations):
+        r = y - level[b]
+        p_l = (1.0 - share[b]) * _normal(r, 0.0, los_sd)
+        p_s = share[b] * _normal(r, -mu, sd)
+        g = p_s / np.maximum(p_l + p_s, 1e-300)
+        wl, ws = (1.0 - g) / los_sd**2, g / sd**2
+        num = np.bincount(b, wl * y + ws * (y + mu), n_bins)
+        den = np.bincount(b, wl + ws, n_bins)
+        level = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+        r = y - level[b]
+        gs = g.sum()
+        mu = float(max(np.sum(g * -r) / gs, 0.0)) if gs > 0 else 0.0
+        los_sd = float(max(np.sqrt(np.sum((1.0 - g) * r**2) / max(np.sum(1.0 - g), 1e-9)), FLOOR_DB))
+        sd = float(max(np.sqrt(np.sum(g * (r + mu) ** 2) / max(gs, 1e-9)), FLOOR_DB))
+        cnt = np.bincount(b, minlength=n_bins)
+        share = np.where(cnt > 0, np.bincount(b, g, n_bins) / np.maximum(cnt, 1), 0.4)
+        share = np.clip(share, 1e-6, 1.0 - 1e-6)
+    return {"level": level, "los_sd": los_sd, "mean": mu, "sd": sd, "share": share, "responsibility": g}
+
+
+def states(tracked_y, above, shadowed) -> np.ndarray:
+    """(M, S) int: 0 line of sight, 1 shadowed, 2 blocked, -1 not above the mask; ``tracked_y`` (M, S) bool where
+    the real file has a C/N0, ``above`` (M, S) bool, ``shadowed`` (M, S) bool."""
+    out = np.full(above.shape, -1)
+    out[above & tracked_y] = 0
+    out[above & tracked_y & shadowed] = 1
+    out[above & ~tracked_y] = 2
+    return out
+
+
+def dwell_times(state, dt: float) -> list:
+    """Mean dwell (s) per state 0, 1, 2 of the sequences ``state`` (M, S) (-1: none): occupancy over exits, with a
+    state's transitions into -1 (setting, the file's end) left out (censored); a state never left: its total time."""
+    a, b = state[:-1], state[1:]
+    valid = (a >= 0) & (b >= 0)
+    out = []
+    for s in range(3):
+        occ = np.sum(valid & (a == s))
+        exits = np.sum(valid & (a == s) & (b != s))
+        out.append(float(dt * occ / exits) if exits else float(dt * max(occ, 1)))
+    return out
+
+
+def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVATION_EDGES_DEG) -> dict | None:
+    """The channel's parameters from real C/N0 ``cn0`` {signal: (M, S) dB-Hz} (on the twin's grid), each signal's
+    C/N0 offset ``offsets`` {signal: dB} (the signal table's plus the fitted one), elevations ``el`` (M, S) rad,
+    ``above`` (M, S) bool the satellite-epochs above the mask (the default twin tracks), interval ``dt`` s.
+
+    Returns {"config": the ``[gnss.shadowing]`` table, "level_dbhz": L_b per bin (None where empty), "los_sd_db",
+    "state_counts"}; None when the file has no C/N0 above the mask."""
+    edges = np.asarray(edges_deg, float)
+    stack = [c - offsets.get(s, 0.0) for s, c in cn0.items() if np.isfinite(c).any()]
+    if not stack:
+        return None
+    with np.errstate(invalid="ignore"):
+        y = np.nanmean(np.stack(stack), axis=0) if len(stack) > 1 else stack[0]
+    el_deg = np.degrees(np.nan_to_num(el, nan=-90.0))
+    above = np.asarray(above, bool) & (el_deg >= edges[0])
+    have = above & np.isfinite(y)
+    if have.sum() < MIN_COUNT:
+        return None
+    n_bins = edges.size - 1
+    b_all = _bins(el_deg, edges)
+    mix = mixture(y[have], b_all[have], n_bins)
+    shadowed = np.zeros(y.shape, bool)
+    shadowed[have] = mix["responsibility"] > 0.5
+    st = states(have, above, shadowed)
+    pooled = np.array([np.mean(st[above] == s) for s in range(3)])
+    probs = []
+    for k in range(n_bins):
+        in_bin = above & (b_all == k)
+        probs.append(np.array([np.mean(st[in_bin] == s) for s in range(3)]) if in_bin.sum() >= MIN_COUNT else pooled)
+    dwell = dwell_times(st, dt)
+    # attenuation's correlation over consecutive shadowed epochs
+    att = np.where(st == 1, mix["level"][b_all] - y, np.nan) - mix["mean"]
+    pair = (st[:-1] == 1) & (st[1:] == 1)
+    x0, x1 = att[:-1][pair], att[1:][pair]
+    rho = float(np.sum(x0 * x1) / np.sqrt(np.sum(x0**2) * np.sum(x1**2))) if pair.sum() >= 10 else None
+    corr = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0)) if rho is not None and 0.0 < rho < 1.0 else dt
+    config = {"elevation_deg": [float(e) for e in edges[:-1]],
+              "shadowed_probability": [round(float(p[1]), 4) for p in probs],
+              "blocked_probability": [round(float(p[2]), 4) for p in probs],
+              "dwell_s": [round(d, 3) for d in dwell], "attenuation_mean_db": round(mix["mean"], 3),
+              "attenuation_sigma_db": round(mix["sd"], 3), "attenuation_correlation_s": round(corr, 3)}
+    counts = np.bincount(b_all[have], minlength=n_bins)
+    level = [float(v) if np.isfinite(v) and n >= 10 else None for v, n in zip(mix["level"], counts)]
+    return {"config": config, "level_dbhz": level,
+            "los_sd_db": mix["los_sd"], "attenuation_lag_one": rho,
+            "state_counts": [int(np.sum(st == s)) for s in range(3)]}
