@@ -8,11 +8,14 @@ attenuation), the shadowed share w_b per bin. The mixture is fitted by expectati
 squares), mu, the two spreads and w_b in closed form; 100 iterations from L_b = the bin's 90th percentile. Each
 satellite-epoch is then classified (shadowed where g > 1/2) and
 
-* the state probabilities per bin are the shares of line of sight, shadowed and blocked among the satellite-epochs
-  above the mask (a bin with fewer than ``MIN_COUNT`` takes the pooled shares);
-* the mean dwell of a state is its occupancy over its exits (epochs in the state followed by another state), times
-  the interval: the maximum-likelihood mean of exponential durations with the runs cut by the file's ends and the
-  satellites' rising and setting left censored, not counted as exits;
+* a hidden Markov chain over each satellite's epochs above the mask with these emissions (line of sight and
+  shadowed: the mixture's two normals; blocked: not tracked) is smoothed by forward-backward and its one-epoch
+  transition matrix A re-estimated (Baum-Welch, started from the counts of the epoch-by-epoch classification,
+  :func:`smooth`): the epoch-by-epoch classification flickers where the two components overlap;
+* the state probabilities per bin are the mean posterior probabilities of line of sight, shadowed and blocked
+  over the satellite-epochs above the mask (a bin with fewer than ``MIN_COUNT`` takes the pooled ones);
+* the mean dwell of state i is -dt / ln A_ii (the simulator's step keeps a state with probability about
+  exp(-dt / D_i));
 * the attenuation's correlation time from the lag-one autocorrelation rho of the attenuation over consecutive
   shadowed epochs, -dt / ln(rho);
 * the gain pattern (the line-of-sight C/N0 against elevation) from L_b: the twin's shadowing then takes the
@@ -79,6 +82,43 @@ def states(tracked_y, above, shadowed) -> np.ndarray:
     return out
 
 
+def smooth(emission, valid, transition, initial, iterations: int = 10):
+    """Forward-backward (Baum-Welch: Rabiner, Proc. IEEE 77(2), 1989) over each satellite's runs of ``valid``
+    (M, S) epochs: ``emission`` (M, S, 3) the likelihood of each epoch under line of sight, shadowed and blocked,
+    ``transition`` (3, 3) one epoch's starting transition matrix, re-estimated ``iterations`` times, ``initial``
+    (3,) the state distribution at a run's first epoch. Returns (posterior state probabilities (M, S, 3), the
+    transition matrix (3, 3)). A loop over epochs, vectorised over satellites (a fit, not a hot path)."""
+    m, n = valid.shape
+    start = valid & ~np.vstack([np.zeros((1, n), bool), valid[:-1]])
+    cont = valid & ~start
+    a = np.asarray(transition, float)
+    post = np.zeros((m, n, 3))
+    for _ in range(iterations):
+        alpha = np.zeros((m, n, 3))
+        prev = np.zeros((n, 3))
+        for k in range(m):
+            f = np.where(start[k][:, None], initial[None, :], prev @ a) * emission[k]
+            f = np.where(valid[k][:, None], f, 0.0)
+            prev = f / np.maximum(f.sum(axis=1, keepdims=True), 1e-300)
+            alpha[k] = prev
+        beta = np.ones((m, n, 3))
+        xi = np.zeros((3, 3))
+        for k in range(m - 2, -1, -1):
+            nxt = cont[k + 1]
+            eb = emission[k + 1] * beta[k + 1]
+            b = eb @ a.T
+            b = b / np.maximum(b.sum(axis=1, keepdims=True), 1e-300)
+            beta[k] = np.where(nxt[:, None], b, 1.0)
+            if nxt.any():
+                x = alpha[k][nxt][:, :, None] * a[None] * eb[nxt][:, None, :]
+                xi += (x / np.maximum(x.sum(axis=(1, 2), keepdims=True), 1e-300)).sum(axis=0)
+        post = alpha * beta
+        post = post / np.maximum(post.sum(axis=2, keepdims=True), 1e-300)
+        rows = xi.sum(axis=1, keepdims=True)
+        a = np.where(rows > 0, xi / np.maximum(rows, 1e-300), a)
+    return np.where(valid[..., None], post, 0.0), a
+
+
 def dwell_times(state, dt: float) -> list:
     """Mean dwell (s) per state 0, 1, 2 of the sequences ``state`` (M, S) (-1: none): occupancy over exits, with a
     state's transitions into -1 (setting, the file's end) left out (censored); a state never left: its total time."""
@@ -116,12 +156,23 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
     shadowed = np.zeros(y.shape, bool)
     shadowed[have] = mix["responsibility"] > 0.5
     st = states(have, above, shadowed)
-    pooled = np.array([np.mean(st[above] == s) for s in range(3)])
+    # the epoch-by-epoch classification flickers where the two components overlap; the hidden Markov chain with
+    # these emissions smooths it, and its transition matrix gives the dwell times
+    r = np.where(have, y - mix["level"][b_all], 0.0)
+    emission = np.stack([np.where(have, _normal(r, 0.0, mix["los_sd"]), 0.0),
+                         np.where(have, _normal(r, -mix["mean"], mix["sd"]), 0.0),
+                         np.where(have, 0.0, 1.0)], axis=-1)
+    counts = np.array([np.mean(st[above] == s) for s in range(3)])
+    start = np.array([[np.sum((st[:-1] == i) & (st[1:] == j)) + 1.0 for j in range(3)] for i in range(3)])
+    post, a = smooth(emission, above, start / start.sum(axis=1, keepdims=True), counts)
+    st = np.where(above, np.argmax(post, axis=-1), -1)
+    pooled = post[above].mean(axis=0)
     probs = []
     for k in range(n_bins):
         in_bin = above & (b_all == k)
-        probs.append(np.array([np.mean(st[in_bin] == s) for s in range(3)]) if in_bin.sum() >= MIN_COUNT else pooled)
-    dwell = dwell_times(st, dt)
+        probs.append(post[in_bin].mean(axis=0) if in_bin.sum() >= MIN_COUNT else pooled)
+    # the simulator's step keeps a state with probability about exp(-dt / D)
+    dwell = [float(-dt / np.log(min(max(a[i, i], 1e-9), 1.0 - 1e-9))) for i in range(3)]
     # attenuation's correlation over consecutive shadowed epochs
     att = np.where(st == 1, mix["level"][b_all] - y, np.nan) - mix["mean"]
     pair = (st[:-1] == 1) & (st[1:] == 1)

@@ -877,13 +877,17 @@ def noise_markdown(fid: dict) -> list:
         for sig, c in sec["cn0"].items():
             out += ["", f"C/N0 {sig}: bias {_fmt(c['bias_dbhz'])}, scatter {_fmt(c['scatter_dbhz'])}, RMS "
                     f"{_fmt(c['rms_dbhz'])} dB-Hz over the bins (sampling alone: {_fmt(c['rms_se_dbhz'])}; chi-square "
-                    f"per bin {_fmt(c['chi2_per_bin'])})" + _cn0_drift_line(c.get("real_against_itself")), "",
-                    "| elevation (deg) | real (dB-Hz) | satellites | twin | twin - real | ± |", "|---|---:|---:|---:|---:|---:|"]
+                    f"per bin {_fmt(c['chi2_per_bin'])})" + _cn0_drift_line(c.get("real_against_itself"))
+                    + f". Spread within the bins (standard deviation of C/N0), twin - real: RMS "
+                    f"{_fmt(c.get('spread_rms_db'))} dB", "",
+                    "| elevation (deg) | real (dB-Hz) | satellites | twin | twin - real | ± | real sd | twin sd |",
+                    "|---|---:|---:|---:|---:|---:|---:|---:|"]
             for b in c["bins"]:
                 if b["difference"] is not None:
                     out.append(f"| {b['bin_deg'][0]:g}-{b['bin_deg'][1]:g} | {_fmt(b['real_dbhz'], 1)} | "
                                f"{b['real_satellites']} | {_fmt(b['twin_dbhz'], 1)} | {_fmt(b['difference'], 1)} | "
-                               f"{_fmt(b['difference_se'], 1)} |")
+                               f"{_fmt(b['difference_se'], 1)} | {_fmt(b.get('real_sd_db'), 1)} | "
+                               f"{_fmt(b.get('twin_sd_db'), 1)} |")
     return out
 
 
