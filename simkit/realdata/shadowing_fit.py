@@ -143,8 +143,12 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
     stack = [c - offsets.get(s, 0.0) for s, c in cn0.items() if np.isfinite(c).any()]
     if not stack:
         return None
-    with np.errstate(invalid="ignore"):
-        y = np.nanmean(np.stack(stack), axis=0) if len(stack) > 1 else stack[0]
+    if len(stack) > 1:
+        st = np.stack(stack)
+        n = np.isfinite(st).sum(axis=0)
+        y = np.where(n > 0, np.nansum(st, axis=0) / np.maximum(n, 1), np.nan)
+    else:
+        y = stack[0]
     el_deg = np.degrees(np.nan_to_num(el, nan=-90.0))
     above = np.asarray(above, bool) & (el_deg >= edges[0])
     have = above & np.isfinite(y)
