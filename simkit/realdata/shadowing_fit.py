@@ -119,17 +119,30 @@ def smooth(emission, valid, transition, initial, iterations: int = 10):
     return np.where(valid[..., None], post, 0.0), a
 
 
-def dwell_times(state, dt: float) -> list:
-    """Mean dwell (s) per state 0, 1, 2 of the sequences ``state`` (M, S) (-1: none): occupancy over exits, with a
-    state's transitions into -1 (setting, the file's end) left out (censored); a state never left: its total time."""
-    a, b = state[:-1], state[1:]
-    valid = (a >= 0) & (b >= 0)
-    out = []
-    for s in range(3):
-        occ = np.sum(valid & (a == s))
-        exits = np.sum(valid & (a == s) & (b != s))
-        out.append(float(dt * occ / exits) if exits else float(dt * max(occ, 1)))
-    return out
+def _channel(y, have, above, b_all, mix, n_bins: int, dt: float):
+    """The states (M, S) (:func:`states` codes), state probabilities per bin [(3,)] and dwell times (s) of the
+    hidden Markov chain with the mixture ``mix``'s emissions (:func:`smooth`)."""
+    shadowed = np.zeros(y.shape, bool)
+    shadowed[have] = mix["responsibility"] > 0.5
+    st = states(have, above, shadowed)
+    # the epoch-by-epoch classification flickers where the two components overlap; the hidden Markov chain with
+    # these emissions smooths it, and its transition matrix gives the dwell times
+    r = np.where(have, y - mix["level"][b_all], 0.0)
+    emission = np.stack([np.where(have, _normal(r, 0.0, mix["los_sd"]), 0.0),
+                         np.where(have, _normal(r, -mix["mean"], mix["sd"]), 0.0),
+                         np.where(have, 0.0, 1.0)], axis=-1)
+    counts = np.array([np.mean(st[above] == s) for s in range(3)])
+    start = np.array([[np.sum((st[:-1] == i) & (st[1:] == j)) + 1.0 for j in range(3)] for i in range(3)])
+    post, a = smooth(emission, above, start / start.sum(axis=1, keepdims=True), counts)
+    st = np.where(above, np.argmax(post, axis=-1), -1)
+    pooled = post[above].mean(axis=0)
+    probs = []
+    for k in range(n_bins):
+        in_bin = above & (b_all == k)
+        probs.append(post[in_bin].mean(axis=0) if in_bin.sum() >= MIN_COUNT else pooled)
+    # the simulator's step keeps a state with probability about exp(-dt / D)
+    dwell = [float(-dt / np.log(min(max(a[i, i], 1e-9), 1.0 - 1e-9))) for i in range(3)]
+    return st, probs, dwell
 
 
 def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVATION_EDGES_DEG) -> dict | None:
@@ -157,26 +170,7 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
     n_bins = edges.size - 1
     b_all = _bins(el_deg, edges)
     mix = mixture(y[have], b_all[have], n_bins)
-    shadowed = np.zeros(y.shape, bool)
-    shadowed[have] = mix["responsibility"] > 0.5
-    st = states(have, above, shadowed)
-    # the epoch-by-epoch classification flickers where the two components overlap; the hidden Markov chain with
-    # these emissions smooths it, and its transition matrix gives the dwell times
-    r = np.where(have, y - mix["level"][b_all], 0.0)
-    emission = np.stack([np.where(have, _normal(r, 0.0, mix["los_sd"]), 0.0),
-                         np.where(have, _normal(r, -mix["mean"], mix["sd"]), 0.0),
-                         np.where(have, 0.0, 1.0)], axis=-1)
-    counts = np.array([np.mean(st[above] == s) for s in range(3)])
-    start = np.array([[np.sum((st[:-1] == i) & (st[1:] == j)) + 1.0 for j in range(3)] for i in range(3)])
-    post, a = smooth(emission, above, start / start.sum(axis=1, keepdims=True), counts)
-    st = np.where(above, np.argmax(post, axis=-1), -1)
-    pooled = post[above].mean(axis=0)
-    probs = []
-    for k in range(n_bins):
-        in_bin = above & (b_all == k)
-        probs.append(post[in_bin].mean(axis=0) if in_bin.sum() >= MIN_COUNT else pooled)
-    # the simulator's step keeps a state with probability about exp(-dt / D)
-    dwell = [float(-dt / np.log(min(max(a[i, i], 1e-9), 1.0 - 1e-9))) for i in range(3)]
+    st, probs, dwell = _channel(y, have, above, b_all, mix, n_bins, dt)
     # attenuation's correlation over consecutive shadowed epochs
     att = np.where(st == 1, mix["level"][b_all] - y, np.nan) - mix["mean"]
     pair = (st[:-1] == 1) & (st[1:] == 1)
