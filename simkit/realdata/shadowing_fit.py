@@ -151,7 +151,8 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
     ``above`` (M, S) bool the satellite-epochs above the mask (the default twin tracks), interval ``dt`` s.
 
     Returns {"config": the ``[gnss.shadowing]`` table, "level_dbhz": L_b per bin (None where empty), "los_sd_db",
-    "state_counts"}; None when the file has no C/N0 above the mask."""
+    "los_offset_db" {signal: mean line-of-sight C/N0 less its offset, minus L_b}, "state_counts"}; None when the
+    file has no C/N0 above the mask."""
     edges = np.asarray(edges_deg, float)
     stack = [c - offsets.get(s, 0.0) for s, c in cn0.items() if np.isfinite(c).any()]
     if not stack:
@@ -182,8 +183,17 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
               "blocked_probability": [round(float(p[2]), 4) for p in probs],
               "dwell_s": [round(d, 3) for d in dwell], "attenuation_mean_db": round(mix["mean"], 3),
               "attenuation_sigma_db": round(mix["sd"], 3), "attenuation_correlation_s": round(corr, 3)}
+    # each signal's line-of-sight level against the pooled one: the offsets fitted to all epochs hold the
+    # signals' (systems') different shares of shadowing
+    los = st == 0
+    shift = {}
+    for sig, c in cn0.items():
+        r = c - offsets.get(sig, 0.0) - mix["level"][b_all]
+        ok = los & np.isfinite(r)
+        if ok.sum() >= MIN_COUNT:
+            shift[sig] = float(np.mean(r[ok]))
     counts = np.bincount(b_all[have], minlength=n_bins)
     level = [float(v) if np.isfinite(v) and n >= 10 else None for v, n in zip(mix["level"], counts)]
     return {"config": config, "level_dbhz": level,
-            "los_sd_db": mix["los_sd"], "attenuation_lag_one": rho,
+            "los_sd_db": mix["los_sd"], "attenuation_lag_one": rho, "los_offset_db": shift,
             "state_counts": [int(np.sum(st == s)) for s in range(3)]}

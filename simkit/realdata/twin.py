@@ -555,7 +555,13 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None, c
     shadow = fit_shadowing(default[1], default[2], ref, fitted) if shadowing and real.get("trajectory") else None
     if shadow is not None:           # a drive: the line-of-sight pattern, and the street's losses as a channel
         fitted["shadowing"] = shadow["config"]
-        fitted["gain_pattern"] = _pattern(shadow["level_dbhz"], fitted)
+        shift = shadow["los_offset_db"]
+        first = [k for k in real["signals"] if k in shift and k not in fitted.get("cn0_offset_db", {})]
+        ref_shift = shift[first[0]] if first else 0.0     # the first signal carries no fitted offset
+        fitted["cn0_offset_db"] = {k: v + shift.get(k, ref_shift) - ref_shift
+                                   for k, v in fitted.get("cn0_offset_db", {}).items()}
+        fitted["gain_pattern"] = _pattern([None if v is None else v + ref_shift for v in shadow["level_dbhz"]],
+                                          fitted)
     code_fit = dict(fitted.get("code_error_scale", {}))
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
     if code_model == "bins":
