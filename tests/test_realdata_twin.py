@@ -10,6 +10,7 @@ import pytest
 from realdata_helpers import KMS3_NAV, KMS3_OBS
 from simkit.cli import main
 from simkit.gnss import signals as sigmod
+from simkit.io import open_dataset, read_gnss
 from simkit.realdata import fidelity, twin
 
 L1, L2 = sigmod.get("L1C"), sigmod.get("L2W")
@@ -207,9 +208,11 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
     real = tmp_path / "real.h5"
     assert main(["import", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "-o", str(real)]) == 0
     assert main(["solve", str(real), "--filter", "spp", "--set", 'estimator.systems="G"']) == 0
-    out = tmp_path / "twin"
+    out, shadowed = tmp_path / "twin", tmp_path / "twin_shadowing"
     assert main(["twin", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "--trajectory", str(real),
-                 "--trajectory-solution", "spp", "-o", str(out), "--fit", "--no-plots"]) == 0
+                 "--trajectory-solution", "spp", "-o", str(out), "--fit", "--no-plots", "--no-shadowing"]) == 0
+    assert main(["twin", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "--trajectory", str(real),
+                 "--trajectory-solution", "spp", "-o", str(shadowed), "--fit", "--no-plots"]) == 0
     capsys.readouterr()
     fid = json.loads((out / "fidelity.json").read_text())
     assert fid["reference"].startswith("moving") and "horizon" in fid and fid["horizon"] is None
@@ -231,6 +234,23 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
             assert c["rms_se_dbhz"] > 0
     fragment = tomllib.loads((out / "fitted.toml").read_text())
     assert "gain_pattern" in fragment["gnss"]["antenna"][0] and "environment" not in fragment
+    assert "shadowing" not in fragment["gnss"]
+    # a drive's street-shadowing channel (docs/shadowing.md): in the fragment, in the calibrated twin's truth, and
+    # the splits' real file against itself beside the twin. Its C/N0 is random: one twin's bin means over 12 s of
+    # one to three satellites per bin are not the receiver's, but the twins pooled are within their sampling
+    fid = json.loads((shadowed / "fidelity.json").read_text())
+    for c in fid["noise"]["in_sample"]["cn0"].values():
+        assert c["chi2_per_bin"] < 2.0
+    out = shadowed
+    fragment = tomllib.loads((out / "fitted.toml").read_text())
+    sh = fragment["gnss"]["shadowing"]
+    assert len(sh["shadowed_probability"]) == len(sh["elevation_deg"]) and len(sh["dwell_s"]) == 3
+    with open_dataset(out / "twin_fit.h5") as ds:
+        state = read_gnss(ds, antennas=0, truth=("shadow_state",)).truth["shadow_state"]
+    assert {0, 1} <= set(np.unique(state))
+    for key in ("holdout", "holdout_interleaved"):
+        for c in fid[key]["noise"]["cn0"].values():
+            assert "real_against_itself" in c and c["spread_rms_db"] is not None
 
 
 def test_twin_refuses_no_realisations_and_an_unknown_code_model(tmp_path, capsys):
