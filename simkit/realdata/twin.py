@@ -881,9 +881,7 @@ def noise_markdown(fid: dict) -> list:
                            f"{b['real_n']} / {b['real_n_eff']:.0f} | {_fmt(b['twin_m'], 3)} | {_fmt(b['ratio'])} | "
                            f"{_fmt(b['ratio_rel_se'])} |")
         for sig, c in sec["cn0"].items():
-            out += ["", f"C/N0 {sig}: bias {_fmt(c['bias_dbhz'])}, scatter {_fmt(c['scatter_dbhz'])}, RMS "
-                    f"{_fmt(c['rms_dbhz'])} dB-Hz over the bins (sampling alone: {_fmt(c['rms_se_dbhz'])}; chi-square "
-                    f"per bin {_fmt(c['chi2_per_bin'])})" + _cn0_drift_line(c.get("real_against_itself"))
+            out += ["", f"C/N0 {sig}: {_cn0_summary(c, ' over the bins')}" + _cn0_drift_line(c.get("real_against_itself"))
                     + f". Spread within the bins (standard deviation of C/N0), twin - real: RMS "
                     f"{_fmt(c.get('spread_rms_db'))} dB", "",
                     "| elevation (deg) | real (dB-Hz) | satellites | twin | twin - real | ± | real sd | twin sd |",
@@ -900,9 +898,14 @@ def noise_markdown(fid: dict) -> list:
 def _cn0_drift_line(d) -> str:
     if not d or not d.get("bins"):
         return ""
-    return (f"; the real file against itself (its bin means here minus those on the epochs fitted on, same bins): "
-            f"bias {_fmt(d['bias_dbhz'])}, scatter {_fmt(d['scatter_dbhz'])}, RMS {_fmt(d['rms_dbhz'])} dB-Hz "
-            f"(sampling alone: {_fmt(d['rms_se_dbhz'])}; chi-square per bin {_fmt(d['chi2_per_bin'])})")
+    return ("; the real file against itself (its bin means here minus those on the epochs fitted on, same bins): "
+            + _cn0_summary(d))
+
+
+def _cn0_summary(c, where: str = "") -> str:
+    """Bias, scatter and RMS of a C/N0 comparison with the RMS of sampling alone and chi-square per bin."""
+    return (f"bias {_fmt(c['bias_dbhz'])}, scatter {_fmt(c['scatter_dbhz'])}, RMS {_fmt(c['rms_dbhz'])} dB-Hz{where} "
+            f"(sampling alone: {_fmt(c['rms_se_dbhz'])}; chi-square per bin {_fmt(c['chi2_per_bin'])})")
 
 
 def _within(ratios: dict, tol: float = 0.2) -> str:
