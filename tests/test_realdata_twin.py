@@ -208,16 +208,17 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
     real = tmp_path / "real.h5"
     assert main(["import", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "-o", str(real)]) == 0
     assert main(["solve", str(real), "--filter", "spp", "--set", 'estimator.systems="G"']) == 0
-    out, shadowed = tmp_path / "twin", tmp_path / "twin_shadowing"
-    assert main(["twin", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "--trajectory", str(real),
-                 "--trajectory-solution", "spp", "-o", str(out), "--fit", "--no-plots", "--no-shadowing"]) == 0
+    shadowed = tmp_path / "twin"
     assert main(["twin", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "--trajectory", str(real),
                  "--trajectory-solution", "spp", "-o", str(shadowed), "--fit", "--no-plots"]) == 0
     capsys.readouterr()
-    fid = json.loads((out / "fidelity.json").read_text())
-    assert fid["reference"].startswith("moving") and "horizon" in fid and fid["horizon"] is None
+    # the calibrated twin without the shadowing term: run beside it into without_shadowing/
+    out = shadowed / "without_shadowing"
+    fid = json.loads((shadowed / "fidelity.json").read_text())["without_shadowing"]
+    fid["default"] = json.loads((shadowed / "fidelity.json").read_text())["default"]
+    assert "horizon" in fid and fid["horizon"] is None
     # the levelled path: one height, the SPP's horizontal positions
-    rows = [r.split(",") for r in (out / "trajectory.csv").read_text().splitlines() if r[0].isdigit()]
+    rows = [r.split(",") for r in (shadowed / "trajectory.csv").read_text().splitlines() if r[0].isdigit()]
     assert len({r[4] for r in rows}) == 1 and len(rows) > 50
     # the fitted gain pattern and C/N0 offsets bring the twin's C/N0 per elevation bin towards the receiver's (in
     # sample; GPS L1 C/A and GLONASS G1 C/A: 12 s of a street, where one pattern cannot be both systems' blockage)
@@ -239,6 +240,8 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
     # the splits' real file against itself beside the twin. Its C/N0 is random: one twin's bin means over 12 s of
     # one to three satellites per bin are not the receiver's, but the twins pooled are within their sampling
     fid = json.loads((shadowed / "fidelity.json").read_text())
+    assert fid["reference"].startswith("moving")
+    assert "C/N0 with and without the street-shadowing term" in (shadowed / "report.md").read_text()
     for c in fid["noise"]["in_sample"]["cn0"].values():
         assert c["chi2_per_bin"] < 2.0
     out = shadowed

@@ -762,8 +762,14 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
     result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
                                                       out_dir / "twin.h5", progress, arrays=True)
     if fit:
-        result.update(_fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress,
-                                     (result["default"], real_grid, twin0), code_model, realisations, shadowing))
+        default = (result["default"], real_grid, twin0)
+        result.update(_fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress, default, code_model,
+                                     realisations, shadowing))
+        if shadowing and result.get("shadowing"):      # the same checks without the term, side by side in report.md
+            sub = out_dir / "without_shadowing"
+            sub.mkdir(exist_ok=True)
+            result["without_shadowing"] = _fit_and_check(real, ref, nav_paths, mask, seed, sub, progress, default,
+                                                         code_model, realisations, False)
     (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
     return result
 
@@ -818,6 +824,7 @@ def report_markdown(fid: dict, figures=()) -> str:
         out += ["", "## Fitted [gnss] parameters", "", "```toml", toml_fragment(fid["fitted_parameters"]).rstrip(),
                 "```"] + [f"- {n}" for n in fid.get("fit_notes", [])]
     out += sisre.report_lines(fid.get("sisre_troposphere")) + acquisition.report_lines(fid.get("acquisition"))
+    out += shadowing_markdown(fid)
     sh = fid.get("shadowing")
     if sh:
         c = sh["config"]
@@ -892,6 +899,45 @@ def noise_markdown(fid: dict) -> list:
                                f"{b['real_satellites']} | {_fmt(b['twin_dbhz'], 1)} | {_fmt(b['difference'], 1)} | "
                                f"{_fmt(b['difference_se'], 1)} | {_fmt(b.get('real_sd_db'), 1)} | "
                                f"{_fmt(b.get('twin_sd_db'), 1)} |")
+    return out
+
+
+def _cn0_rows(fid: dict) -> dict:
+    """{(comparison, signal): (C/N0 comparison, visibility agreement)} of a fitted twin's noise checks."""
+    out = {}
+    for title, sec in _noise_sections(fid):
+        key = title.split(" (")[0]
+        vis = fid["fitted"] if key == "in sample" else next(
+            fid[k] for k in ("holdout", "holdout_interleaved") if fid.get(k, {}).get("noise") is sec)
+        for sig, c in sec["cn0"].items():
+            out[(key, sig)] = (c, vis["visibility_agreement"])
+    return out
+
+
+def shadowing_markdown(fid: dict) -> list:
+    """report.md's table of the C/N0 comparisons with and without the street-shadowing term (docs/shadowing.md),
+    with the real file against itself beside: RMS over the bins of the bin means (chi-square per bin), RMS of the
+    spreads within the bins, visibility agreement."""
+    if "without_shadowing" not in fid:
+        return []
+    on, off = _cn0_rows(fid), _cn0_rows(fid["without_shadowing"])
+    out = ["", "## C/N0 with and without the street-shadowing term", "",
+           "RMS over the 10-degree bins of twin - real bin means (chi-square per bin), and of the C/N0 spreads within "
+           "the bins; the real file against itself on the splits (docs/shadowing.md).", "",
+           "| comparison | signal | without: means | spread | visibility | with: means | spread | visibility | "
+           "real against itself |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+
+    def cell(c):
+        return f"{_fmt(c['rms_dbhz'])} ({_fmt(c['chi2_per_bin'])})"
+
+    for key, (c_on, v_on) in on.items():
+        if key not in off:
+            continue
+        c_off, v_off = off[key]
+        rr = c_on.get("real_against_itself") or {}
+        out.append(f"| {key[0]} | {key[1]} | {cell(c_off)} | {_fmt(c_off.get('spread_rms_db'))} | "
+                   f"{_fmt(100 * v_off, 1)} % | {cell(c_on)} | {_fmt(c_on.get('spread_rms_db'))} | "
+                   f"{_fmt(100 * v_on, 1)} % | {cell(rr) if rr.get('bins') else '-'} |")
     return out
 
 
