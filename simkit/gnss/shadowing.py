@@ -158,6 +158,15 @@ def transition(pi, dwell, step) -> np.ndarray:
     return (vec * np.exp(lam * step)) @ vec.T * root[None, :] / root[:, None]
 
 
+@numba.njit(cache=True, inline="always")
+def _entry(vec, lam, pi, b, i, j, h):
+    """P_ij = expm(Q h)_ij of bin b from its spectral tables (clipped at 0 against rounding)."""
+    v = 0.0
+    for e in range(3):
+        v += vec[b, i, e] * vec[b, j, e] * np.exp(lam[b, e] * h)
+    return max(v * np.sqrt(pi[b, j] / pi[b, i]), 0.0)
+
+
 @numba.njit(cache=True)
 def _chains(bins, step, lam, vec, pi, u, z, state, x, a_step_per_unit, out_state, out_x):
     """Run chains (M, K) epoch by epoch: ``bins`` (M, K) int (-1: no chain), ``step`` (M,) the step before each
@@ -179,17 +188,10 @@ def _chains(bins, step, lam, vec, pi, u, z, state, x, a_step_per_unit, out_state
                 xc = z[i, c]
             else:
                 h = step[i]
-                total = 0.0
-                row = np.zeros(3)
-                for j in range(3):
-                    v = 0.0
-                    for e in range(3):
-                        v += vec[b, s, e] * vec[b, j, e] * np.exp(lam[b, e] * h)
-                    v *= np.sqrt(pi[b, j] / pi[b, s])
-                    row[j] = max(v, 0.0)
-                    total += row[j]
-                r = u[i, c] * total
-                s = 0 if r < row[0] else (1 if r < row[0] + row[1] else 2)
+                p0 = _entry(vec, lam, pi, b, s, 0, h)
+                p1 = _entry(vec, lam, pi, b, s, 1, h)
+                r = u[i, c] * (p0 + p1 + _entry(vec, lam, pi, b, s, 2, h))
+                s = 0 if r < p0 else (1 if r < p0 + p1 else 2)
                 a = np.exp(-h * a_step_per_unit)
                 xc = a * xc + np.sqrt(1.0 - a * a) * z[i, c]
             out_state[i, c] = s
