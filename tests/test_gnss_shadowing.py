@@ -102,6 +102,21 @@ def test_the_elevation_bins_select_their_probabilities():
     assert np.allclose(share, PI[1], atol=0.012)
 
 
+def test_a_system_table_overrides_the_shared_probabilities():
+    own = np.array([[0.8, 0.1, 0.1], [0.8, 0.1, 0.1]])
+    cfg = ShadowingConfig(**{**_cfg().__dict__, "systems": (("R", tuple(own.ravel())),)})
+    ids = [f"G{k:03d}" for k in range(150)] + [f"R{k:03d}" for k in range(150)]
+    sh = Shadowing(cfg, 5, ids, 1, 1.0)
+    el = np.full((2000, 300), np.radians(10.0))
+    st = sh.advance(0, el, np.ones(el.shape, bool), np.zeros(2000), np.arange(300)).state[:, 0]
+    for cols, pi in ((slice(0, 150), PI[0]), (slice(150, 300), own[0])):
+        share = np.array([(st[:, cols] == s).mean() for s in (LOS, SHADOWED, BLOCKED)])
+        assert np.allclose(share, pi, atol=0.015)
+    # the GPS chains are the ones without the GLONASS table (their streams are keyed by satellite)
+    plain = Shadowing(_cfg(), 5, ids, 1, 1.0).advance(0, el, np.ones(el.shape, bool), np.zeros(2000), np.arange(300))
+    assert np.array_equal(plain.state[:, 0, :150], st[:, :150])
+
+
 def test_dwell_in_metres_runs_with_the_distance_travelled():
     speed = np.full(2000, 2.0)
     metres, _ = _run(_cfg("m", corr=8.0, dwell=tuple(2 * d for d in DWELL)), n_chains=50, m=2000, speed=speed)
@@ -209,6 +224,8 @@ def test_reacquisition_after_a_blockage_follows_the_acquisition_delay(tmp_path):
     ({"antennas": "each"}, "antennas"),
     ({"attenuation_mean_db": -1.0}, "attenuation_mean_db"),
     ({"dwel_s": 1.0}, "dwel_s"),
+    ({"systems": {"X": {"shadowed_probability": [0.1] * 3, "blocked_probability": [0.1] * 3}}}, "systems.X"),
+    ({"systems": {"R": {"shadowed_probability": [0.1] * 3}}}, r"systems\.R\.blocked_probability"),
 ])
 def test_a_malformed_table_is_one_error_naming_its_key(bad, key):
     with pytest.raises(ScenarioError, match=rf"gnss\.shadowing\.{key}"):

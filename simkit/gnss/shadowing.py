@@ -8,7 +8,7 @@ al., "The land mobile satellite communication channel - recording, statistics, a
 Technol. 40(2), 1991: two states; Perez-Fontan et al., "Statistical modeling of the LMS channel using a time-series
 generator", IEEE Trans. Aerosp. Electron. Syst. 37(3), 2001: three states with tables per elevation and
 environment; ITU-R P.681, the state model of its land mobile section). simkit keeps the three states and their
-elevation dependence; the parameters are the scenario's (``simkit twin --fit`` estimates them from a real drive,
+elevation dependence (optionally a table per system: ``[gnss.shadowing.systems.<letter>]``); the parameters are the scenario's (``simkit twin --fit`` estimates them from a real drive,
 docs/real_data.md); no table of the papers is built in.
 
 The chain is a continuous-time Markov process with generator Q (per elevation bin b): stationary probabilities
@@ -49,6 +49,7 @@ DRAWS_PER_EPOCH = 2
 _HALF_ULP = 2.0**-54
 _PI_FLOOR = 1e-9           # a state of zero probability keeps a tiny one, so Pi^(-1/2) exists
 ANTENNA_MODES = ("common", "independent")
+_SYSTEMS = ("G", "C", "E", "R", "J")
 
 
 @dataclass(frozen=True)
@@ -67,10 +68,15 @@ class ShadowingConfig:
     attenuation_sigma_db: float
     attenuation_correlation: float
     antennas: str = "common"
+    systems: tuple = ()          # ((system letter, probabilities (B * 3,)), ...): a system's own state probabilities
 
     @property
     def pi(self) -> np.ndarray:
         return np.asarray(self.probabilities, float).reshape(-1, 3)
+
+    def tables(self) -> tuple[list, np.ndarray]:
+        """(system letters with their own table, [(B, 3) probabilities]: the shared table first, then theirs)."""
+        return [k for k, _ in self.systems], [self.pi] + [np.asarray(p, float).reshape(-1, 3) for _, p in self.systems]
 
 
 def parse_shadowing(sec: Section) -> ShadowingConfig | None:
@@ -83,14 +89,15 @@ def parse_shadowing(sec: Section) -> ShadowingConfig | None:
     if n == 0 or any(b <= a for a, b in zip(edges[:-1], edges[1:])) or not -90.0 <= edges[0] < 90.0 \
             or edges[-1] >= 90.0:
         raise sec.error("elevation_deg", f"expected ascending lower bin edges in [-90, 90) deg, got {edges!r}")
-    shadowed = sec.get("shadowed_probability", float, shape=n)
-    blocked = sec.get("blocked_probability", float, shape=n)
-    for key, vals in (("shadowed_probability", shadowed), ("blocked_probability", blocked)):
-        if any(not 0.0 <= v <= 1.0 for v in vals):
-            raise sec.error(key, f"expected probabilities in [0, 1], one per elevation bin, got {vals!r}")
-    if any(s + b > 1.0 + 1e-9 for s, b in zip(shadowed, blocked)):
-        raise sec.error("blocked_probability", "shadowed_probability + blocked_probability must be <= 1 in every "
-                        f"elevation bin, got {shadowed!r} and {blocked!r}")
+    pi = _probabilities(sec, n)
+    systems = sec.section("systems")
+    own = []
+    for letter in list(systems.data):
+        if letter not in _SYSTEMS:
+            raise systems.error(letter, f"unknown system (expected one of {', '.join(_SYSTEMS)})")
+        sub = systems.section(letter)
+        own.append((letter, tuple(x for row in _probabilities(sub, n) for x in row)))
+        sub.done()
     has_s, has_m = sec.has("dwell_s"), sec.has("dwell_m")
     if has_s == has_m:
         raise sec.error("dwell_s", "expected exactly one of dwell_s (seconds) and dwell_m (metres travelled): "
@@ -110,11 +117,23 @@ def parse_shadowing(sec: Section) -> ShadowingConfig | None:
                    check=lambda v: None if v > 0 else "must be > 0")
     antennas = sec.get("antennas", str, "common", choices=ANTENNA_MODES)
     sec.done()
-    pi = [(1.0 - s - b, s, b) for s, b in zip(shadowed, blocked)]
     return ShadowingConfig(elevation_edges_rad=tuple(np.radians(edges)),
-                           probabilities=tuple(max(0.0, x) for row in pi for x in row), dwell=tuple(dwell),
+                           probabilities=tuple(x for row in pi for x in row), dwell=tuple(dwell),
                            unit=unit, attenuation_mean_db=mean, attenuation_sigma_db=sigma,
-                           attenuation_correlation=corr, antennas=antennas)
+                           attenuation_correlation=corr, antennas=antennas, systems=tuple(own))
+
+
+def _probabilities(sec: Section, n: int) -> list:
+    """[(line of sight, shadowed, blocked)] per bin from ``shadowed_probability`` and ``blocked_probability``."""
+    shadowed = sec.get("shadowed_probability", float, shape=n)
+    blocked = sec.get("blocked_probability", float, shape=n)
+    for key, vals in (("shadowed_probability", shadowed), ("blocked_probability", blocked)):
+        if any(not 0.0 <= v <= 1.0 for v in vals):
+            raise sec.error(key, f"expected probabilities in [0, 1], one per elevation bin, got {vals!r}")
+    if any(s + b > 1.0 + 1e-9 for s, b in zip(shadowed, blocked)):
+        raise sec.error("blocked_probability", "shadowed_probability + blocked_probability must be <= 1 in every "
+                        f"elevation bin, got {shadowed!r} and {blocked!r}")
+    return [(max(0.0, 1.0 - s - b), s, b) for s, b in zip(shadowed, blocked)]
 
 
 def fluxes(pi, dwell) -> np.ndarray:
@@ -219,11 +238,15 @@ class Shadowing:
         self.position = np.zeros(n, dtype=np.int64)
         self.state = np.full(n, -1, dtype=np.int64)
         self.x = np.zeros(n)
-        tables = [_spectral(p, cfg.dwell) for p in cfg.pi]
+        letters, probs = cfg.tables()
+        tables = [_spectral(p, cfg.dwell) for table in probs for p in table]      # (table, bin) flattened
         self.lam = np.array([t[0] for t in tables])
         self.vec = np.array([t[1] for t in tables])
         self.pi = np.array([t[2] for t in tables])
         self.edges = np.asarray(cfg.elevation_edges_rad, float)
+        # each satellite's first row in the tables: its system's own, else the shared one
+        self.offset = np.array([(letters.index(sid[0]) + 1 if sid[0] in letters else 0) * self.edges.size
+                                for sid in sat_ids], dtype=np.int64)
 
     def _uniforms(self, k0: int, m: int, cols) -> np.ndarray:
         """(2, M, chains, C) uniforms in (0, 1) of epochs k0 .. k0 + m - 1."""
@@ -252,7 +275,7 @@ class Shadowing:
         self.state[:, off] = -1
         u = self._uniforms(k0, m, cols)
         b = np.clip(np.searchsorted(self.edges, np.nan_to_num(elevation, nan=-10.0), side="right") - 1, 0, None)
-        bins = np.where(present, b, -1).astype(np.int64)
+        bins = np.where(present, b + self.offset[cols][None, :], -1).astype(np.int64)
         bins = np.ascontiguousarray(np.broadcast_to(bins[:, None, :], (m, nch, cols.size)).reshape(m, -1))
         step = np.full(m, self.dt) if self.cfg.unit == "s" else np.abs(np.asarray(speed, float)) * self.dt
         st, x = self.state[:, cols].reshape(-1).copy(), self.x[:, cols].reshape(-1).copy()

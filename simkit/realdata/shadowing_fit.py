@@ -135,20 +135,35 @@ def _channel(y, have, above, b_all, mix, n_bins: int, dt: float):
     start = np.array([[np.sum((st[:-1] == i) & (st[1:] == j)) + 1.0 for j in range(3)] for i in range(3)])
     post, a = smooth(emission, above, start / start.sum(axis=1, keepdims=True), counts)
     st = np.where(above, np.argmax(post, axis=-1), -1)
-    pooled = post[above].mean(axis=0)
-    probs = []
-    for k in range(n_bins):
-        in_bin = above & (b_all == k)
-        probs.append(post[in_bin].mean(axis=0) if in_bin.sum() >= MIN_COUNT else pooled)
+    probs = shares(post, above, b_all, n_bins)
     # the simulator's step keeps a state with probability about exp(-dt / D)
     dwell = [float(-dt / np.log(min(max(a[i, i], 1e-9), 1.0 - 1e-9))) for i in range(3)]
-    return st, probs, dwell
+    return st, probs, dwell, post
 
 
-def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVATION_EDGES_DEG) -> dict | None:
+def shares(post, where, b_all, n_bins: int) -> list:
+    """[(3,)] per bin: the mean posterior state probabilities ``post`` (M, S, 3) over the satellite-epochs ``where``
+    (M, S) of the bin; a bin with fewer than ``MIN_COUNT`` takes those pooled over ``where``."""
+    pooled = post[where].mean(axis=0)
+    out = []
+    for k in range(n_bins):
+        in_bin = where & (b_all == k)
+        out.append(post[in_bin].mean(axis=0) if in_bin.sum() >= MIN_COUNT else pooled)
+    return out
+
+
+def _table(probs) -> dict:
+    return {"shadowed_probability": [round(float(p[1]), 4) for p in probs],
+            "blocked_probability": [round(float(p[2]), 4) for p in probs]}
+
+
+def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVATION_EDGES_DEG,
+        systems=None) -> dict | None:
     """The channel's parameters from real C/N0 ``cn0`` {signal: (M, S) dB-Hz} (on the twin's grid), each signal's
     C/N0 offset ``offsets`` {signal: dB} (the signal table's plus the fitted one), elevations ``el`` (M, S) rad,
-    ``above`` (M, S) bool the satellite-epochs above the mask (the default twin tracks), interval ``dt`` s.
+    ``above`` (M, S) bool the satellite-epochs above the mask (the default twin tracks), interval ``dt`` s;
+    ``systems`` (S,) the columns' system letters: with two or more systems each gets its own state probabilities
+    (``systems`` in the table; the levels, attenuation and dwell times are shared).
 
     Returns {"config": the ``[gnss.shadowing]`` table, "level_dbhz": L_b per bin (None where empty), "los_sd_db",
     "los_offset_db" {signal: mean line-of-sight C/N0 less its offset, minus L_b}, "state_counts"}; None when the
@@ -171,7 +186,7 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
     n_bins = edges.size - 1
     b_all = _bins(el_deg, edges)
     mix = mixture(y[have], b_all[have], n_bins)
-    st, probs, dwell = _channel(y, have, above, b_all, mix, n_bins, dt)
+    st, probs, dwell, post = _channel(y, have, above, b_all, mix, n_bins, dt)
     # attenuation's correlation over consecutive shadowed epochs
     att = np.where(st == 1, mix["level"][b_all] - y, np.nan) - mix["mean"]
     pair = (st[:-1] == 1) & (st[1:] == 1)
@@ -179,8 +194,7 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
     rho = float(np.sum(x0 * x1) / np.sqrt(np.sum(x0**2) * np.sum(x1**2))) if pair.sum() >= 10 else None
     corr = float(np.clip(-dt / np.log(rho), dt / 5.0, 3600.0)) if rho is not None and 0.0 < rho < 1.0 else dt
     config = {"elevation_deg": [float(e) for e in edges[:-1]],
-              "shadowed_probability": [round(float(p[1]), 4) for p in probs],
-              "blocked_probability": [round(float(p[2]), 4) for p in probs],
+              **_table(probs),
               "dwell_s": [round(d, 3) for d in dwell], "attenuation_mean_db": round(mix["mean"], 3),
               "attenuation_sigma_db": round(mix["sd"], 3), "attenuation_correlation_s": round(corr, 3)}
     # each signal's line-of-sight level against the pooled one: the offsets fitted to all epochs hold the
@@ -192,6 +206,13 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
         ok = los & np.isfinite(r)
         if ok.sum() >= MIN_COUNT:
             shift[sig] = float(np.mean(r[ok]))
+    # a system's own state probabilities (GLONASS and GPS satellites of one drive need not share a street's)
+    letters = sorted(set(systems)) if systems is not None else []
+    own = {k: np.asarray(systems) == k for k in letters}
+    own = {k: _table(shares(post, above & cols[None, :], b_all, n_bins)) for k, cols in own.items()
+           if (above & cols[None, :]).sum() >= MIN_COUNT}
+    if len(own) > 1:
+        config["systems"] = own
     counts = np.bincount(b_all[have], minlength=n_bins)
     level = [float(v) if np.isfinite(v) and n >= 10 else None for v, n in zip(mix["level"], counts)]
     return {"config": config, "level_dbhz": level,

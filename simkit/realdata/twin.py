@@ -428,8 +428,9 @@ def toml_fragment(p: dict) -> str:
         sh = p["shadowing"]
         lines += ["", "# street shadowing: a Markov channel per satellite (line of sight / shadowed / blocked) from the "
                   "real C/N0 series (shadowing_fit.py)", "[gnss.shadowing]"]
-        lines += [f"{k} = {_toml_value(v) if not isinstance(v, list) else '[' + ', '.join(f'{x:g}' for x in v) + ']'}"
-                  for k, v in sh.items()]
+        lines += [f"{k} = {_toml_list(v)}" for k, v in sh.items() if k != "systems"]
+        for letter, table in sh.get("systems", {}).items():
+            lines += [f"[gnss.shadowing.systems.{letter}]", *(f"{k} = {_toml_list(v)}" for k, v in table.items())]
     if p.get("acquisition"):
         lines += ["", "# rising satellites: first tracked this long after they cross the mask (acquisition.py)",
                   "[gnss.acquisition]", f"delay_s = {p['acquisition']['delay_s']:.1f}"]
@@ -440,6 +441,10 @@ def toml_fragment(p: dict) -> str:
                   f"azimuth_deg = [{', '.join(f'{a:g}' for a in tab['azimuth_deg'])}]",
                   f"elevation_deg = [{', '.join(f'{e:g}' for e in tab['elevation_deg'])}]"]
     return "\n".join(lines) + "\n"
+
+
+def _toml_list(v) -> str:
+    return "[" + ", ".join(f"{x:g}" for x in v) + "]" if isinstance(v, list) else _toml_value(v)
 
 
 def _toml_value(v) -> str:
@@ -591,7 +596,8 @@ def fit_shadowing(real_on_grid: dict, twin: dict, reference, p: dict) -> dict | 
     el = fidelity.elevations(twin["sat_pos"], reference)
     dt = float(np.median(np.diff(twin["t"]))) if twin["t"].size > 1 else 1.0
     offsets = {s: _cn0_offset(sigmod.get(s), p) for s in real_on_grid["signals"]}
-    return shadowing_fit.fit(real_on_grid["obs"]["cn0"], offsets, el, fidelity.tracked(twin["obs"]), dt)
+    return shadowing_fit.fit(real_on_grid["obs"]["cn0"], offsets, el, fidelity.tracked(twin["obs"]), dt,
+                             systems=[str(s)[0] for s in twin["sat_id"]])
 
 
 def _rows(arr: dict, rows) -> dict:
