@@ -38,8 +38,13 @@ def test_the_fit_recovers_the_channel_of_a_simulated_file(tmp_path):
     noise = np.random.default_rng(0)
     cn0 = {s: g.obs["cn0"][s] + noise.normal(0.0, 1.0, el.shape) for s in g.signals}
     offsets = {s: sigmod.get(s).cn0_offset_db for s in g.signals}
-    out = shadowing_fit.fit(cn0, offsets, el, above, 1.0)
+    out = shadowing_fit.fit(cn0, offsets, el, above, 1.0, systems=[str(x)[0] for x in g.sat_id])
     c = out["config"]
+    # both systems were simulated with the one table: each system's own fit is near the pooled one
+    assert set(c["systems"]) == {"G", "C"}
+    for table in c["systems"].values():
+        for key in ("shadowed_probability", "blocked_probability"):
+            assert np.allclose(table[key][1:7], c[key][1:7], atol=0.08)
     # state shares per 10-degree bin against the true ones of the bin that holds it (bins with data)
     n = np.bincount(np.clip((np.degrees(el[above]) // 10).astype(int), 0, 8), minlength=9)
     checked = 0

@@ -157,6 +157,29 @@ def _table(probs) -> dict:
             "blocked_probability": [round(float(p[2]), 4) for p in probs]}
 
 
+def _los_offsets(cn0: dict, offsets: dict, level, los) -> dict:
+    """{signal: mean line-of-sight C/N0 less its offset minus the pooled level ``level`` (M, S)} over ``los`` (M, S):
+    the offsets fitted to all epochs hold the signals' (systems') different shares of shadowing."""
+    shift = {}
+    for sig, c in cn0.items():
+        r = c - offsets.get(sig, 0.0) - level
+        ok = los & np.isfinite(r)
+        if ok.sum() >= MIN_COUNT:
+            shift[sig] = float(np.mean(r[ok]))
+    return shift
+
+
+def _system_tables(systems, post, above, b_all, n_bins: int) -> dict:
+    """{system letter: its own state-probability table} (GLONASS and GPS satellites of one drive need not be
+    blocked alike), for the systems of ``systems`` (S,) with ``MIN_COUNT`` satellite-epochs above the mask."""
+    out = {}
+    for k in sorted(set(systems)) if systems is not None else []:
+        where = above & (np.asarray(systems) == k)[None, :]
+        if where.sum() >= MIN_COUNT:
+            out[k] = _table(shares(post, where, b_all, n_bins))
+    return out
+
+
 def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVATION_EDGES_DEG,
         systems=None) -> dict | None:
     """The channel's parameters from real C/N0 ``cn0`` {signal: (M, S) dB-Hz} (on the twin's grid), each signal's
@@ -197,20 +220,8 @@ def fit(cn0: dict, offsets: dict, el, above, dt: float, edges_deg=fidelity.ELEVA
               **_table(probs),
               "dwell_s": [round(d, 3) for d in dwell], "attenuation_mean_db": round(mix["mean"], 3),
               "attenuation_sigma_db": round(mix["sd"], 3), "attenuation_correlation_s": round(corr, 3)}
-    # each signal's line-of-sight level against the pooled one: the offsets fitted to all epochs hold the
-    # signals' (systems') different shares of shadowing
-    los = st == 0
-    shift = {}
-    for sig, c in cn0.items():
-        r = c - offsets.get(sig, 0.0) - mix["level"][b_all]
-        ok = los & np.isfinite(r)
-        if ok.sum() >= MIN_COUNT:
-            shift[sig] = float(np.mean(r[ok]))
-    # a system's own state probabilities (GLONASS and GPS satellites of one drive need not share a street's)
-    letters = sorted(set(systems)) if systems is not None else []
-    own = {k: np.asarray(systems) == k for k in letters}
-    own = {k: _table(shares(post, above & cols[None, :], b_all, n_bins)) for k, cols in own.items()
-           if (above & cols[None, :]).sum() >= MIN_COUNT}
+    shift = _los_offsets(cn0, offsets, mix["level"][b_all], st == 0)
+    own = _system_tables(systems, post, above, b_all, n_bins)
     if len(own) > 1:
         config["systems"] = own
     counts = np.bincount(b_all[have], minlength=n_bins)
