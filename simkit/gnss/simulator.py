@@ -41,7 +41,7 @@ from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
 from .columns import place_columns
 from .orbit_range import range_errors
-from .shadowing import Shadowing
+from .shadowing import BLOCKED, Shadowing
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
 from .tropo_truth import TruthTroposphere
@@ -216,7 +216,7 @@ class GnssSimulator:
                 shadow = self.shadowing.advance(k0, el_c, el_c >= low - _MASK_MARGIN_RAD,
                                                 np.linalg.norm(np.asarray(vel_ecef, float).reshape(t.size, 3), axis=1),
                                                 cand)
-            vis_c = vis_c & (shadow.state != 2)
+            vis_c = vis_c & (shadow.state != BLOCKED)
         vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
         parts = _Parts(self, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, los, shadow)

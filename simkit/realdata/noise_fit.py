@@ -233,10 +233,10 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
             se = float(np.hypot(a["se"], b["se"])) if d is not None else None
             if d is not None:
                 ses.append(se)
-            sd_r, sd_t = _in_bin(rr, el_deg, lo, hi), _in_bin(pooled, pel, lo, hi)
-            sd_r = float(np.nanstd(sd_r)) if d is not None else None
-            sd_t = float(np.nanstd(sd_t)) if d is not None else None
-            if d is not None:
+            sd_r = sd_t = None
+            if d is not None:      # the spread of the values within the bin, real and twin
+                sd_r = float(np.nanstd(_in_bin(rr, el_deg, lo, hi)))
+                sd_t = float(np.nanstd(_in_bin(pooled, pel, lo, hi)))
                 spread.append(sd_t - sd_r)
             rows.append({"bin_deg": [float(lo), float(hi)], "real_dbhz": a["mean"], "real_n": a["n"],
                          "real_satellites": a["satellites"], "real_se": a["se"], "twin_dbhz": b["mean"],
