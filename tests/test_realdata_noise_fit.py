@@ -106,6 +106,28 @@ def test_cn0_comparison_splits_the_difference_into_bias_and_scatter():
     assert d[:4] == pytest.approx(2.0, abs=0.3) and d[5:] == pytest.approx(0.0, abs=0.3)
 
 
+def test_cn0_spread_and_the_real_file_against_itself_in_closed_form():
+    rng = np.random.default_rng(6)
+    el = np.radians(np.tile(np.linspace(5, 85, 30), (400, 1)))
+    level = 30 + 15 * np.sin(el)
+    real = level + 5.0 * rng.standard_normal(el.shape)             # a street: 5 dB of spread about the level
+    twin = level + 2.0 * rng.standard_normal(el.shape)             # a twin with too little of it
+    c = noise_fit.cn0_comparison({"L1C": real}, [{"L1C": twin}], el, np.arange(0.0, 91.0, 10.0))["L1C"]
+    # the spread within a bin is the noise plus the level's own variation over the bin (same in both files)
+    for b in c["bins"]:
+        in_bin = (np.degrees(el[0]) >= b["bin_deg"][0]) & (np.degrees(el[0]) < b["bin_deg"][1])
+        lv = np.var(level[0, in_bin])
+        assert b["real_sd_db"] == pytest.approx(np.sqrt(25.0 + lv), rel=0.05)
+        assert b["twin_sd_db"] == pytest.approx(np.sqrt(4.0 + lv), rel=0.05)
+    assert 2.0 < c["spread_rms_db"] < 3.5
+    # the real file against itself: the same epochs give 0; the other epochs 2 dB higher give a bias of -2
+    same = noise_fit.cn0_drift([dict(b) for b in c["bins"]], real, el)
+    assert same["rms_dbhz"] == pytest.approx(0.0, abs=1e-9) and same["bins"] == 9
+    up = noise_fit.cn0_drift([dict(b) for b in c["bins"]], real + 2.0, el)
+    assert up["bias_dbhz"] == pytest.approx(-2.0) and up["scatter_dbhz"] == pytest.approx(0.0, abs=1e-9)
+    assert up["chi2_per_bin"] > 0
+
+
 @pytest.mark.parametrize("m", [19, 60, 1375])
 def test_splits_fit_and_check_disjoint_blocks_long_enough_for_an_arc(m):
     t = np.arange(m) * 1.0

@@ -10,6 +10,7 @@ import pytest
 from realdata_helpers import KMS3_NAV, KMS3_OBS
 from simkit.cli import main
 from simkit.gnss import signals as sigmod
+from simkit.io import open_dataset, read_gnss
 from simkit.realdata import fidelity, twin
 
 L1, L2 = sigmod.get("L1C"), sigmod.get("L2W")
@@ -232,14 +233,17 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
     real = tmp_path / "real.h5"
     assert main(["import", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "-o", str(real)]) == 0
     assert main(["solve", str(real), "--filter", "spp", "--set", 'estimator.systems="G"']) == 0
-    out = tmp_path / "twin"
+    shadowed = tmp_path / "twin"
     assert main(["twin", str(BERLIN_OBS), "--nav", str(BERLIN_NAV), "--trajectory", str(real),
-                 "--trajectory-solution", "spp", "-o", str(out), "--fit", "--no-plots"]) == 0
+                 "--trajectory-solution", "spp", "-o", str(shadowed), "--fit", "--no-plots"]) == 0
     capsys.readouterr()
-    fid = json.loads((out / "fidelity.json").read_text())
-    assert fid["reference"].startswith("moving") and "horizon" in fid and fid["horizon"] is None
+    # the calibrated twin without the shadowing term: run beside it into without_shadowing/
+    out = shadowed / "without_shadowing"
+    fid = json.loads((shadowed / "fidelity.json").read_text())["without_shadowing"]
+    fid["default"] = json.loads((shadowed / "fidelity.json").read_text())["default"]
+    assert "horizon" in fid and fid["horizon"] is None
     # the levelled path: one height, the SPP's horizontal positions
-    rows = [r.split(",") for r in (out / "trajectory.csv").read_text().splitlines() if r[0].isdigit()]
+    rows = [r.split(",") for r in (shadowed / "trajectory.csv").read_text().splitlines() if r[0].isdigit()]
     assert len({r[4] for r in rows}) == 1 and len(rows) > 50
     # the fitted gain pattern and C/N0 offsets bring the twin's C/N0 per elevation bin towards the receiver's (in
     # sample; GPS L1 C/A and GLONASS G1 C/A: 12 s of a street, where one pattern cannot be both systems' blockage)
@@ -257,6 +261,25 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
             assert c["rms_se_dbhz"] > 0
     fragment = tomllib.loads((out / "fitted.toml").read_text())
     assert "gain_pattern" in fragment["gnss"]["antenna"][0] and "environment" not in fragment
+    assert "shadowing" not in fragment["gnss"]
+    # a drive's street-shadowing channel (docs/shadowing.md): in the fragment, in the calibrated twin's truth, and
+    # the splits' real file against itself beside the twin. Its C/N0 is random: one twin's bin means over 12 s of
+    # one to three satellites per bin are not the receiver's, but the twins pooled are within their sampling
+    fid = json.loads((shadowed / "fidelity.json").read_text())
+    assert fid["reference"].startswith("moving")
+    assert "C/N0 with and without the street-shadowing term" in (shadowed / "report.md").read_text()
+    for c in fid["noise"]["in_sample"]["cn0"].values():
+        assert c["chi2_per_bin"] < 2.0
+    out = shadowed
+    fragment = tomllib.loads((out / "fitted.toml").read_text())
+    sh = fragment["gnss"]["shadowing"]
+    assert len(sh["shadowed_probability"]) == len(sh["elevation_deg"]) and len(sh["dwell_s"]) == 3
+    with open_dataset(out / "twin_fit.h5") as ds:
+        state = read_gnss(ds, antennas=0, truth=("shadow_state",)).truth["shadow_state"]
+    assert {0, 1} <= set(np.unique(state))
+    for key in ("holdout", "holdout_interleaved"):
+        for c in fid[key]["noise"]["cn0"].values():
+            assert "real_against_itself" in c and c["spread_rms_db"] is not None
 
 
 def test_twin_refuses_no_realisations_and_an_unknown_code_model(tmp_path, capsys):

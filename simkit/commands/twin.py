@@ -27,6 +27,8 @@ def add_parser(sub):
                    help="--fit's code-noise correction: a line in elevation per signal (default) or a factor per bin")
     p.add_argument("--realisations", type=int, default=4, metavar="N",
                    help="twins (seeds) pooled for the twin's code noise and C/N0 in the checks (default 4)")
+    p.add_argument("--no-shadowing", action="store_true",
+                   help="--fit of a moving receiver without the street-shadowing channel ([gnss.shadowing])")
     p.add_argument("--no-plots", action="store_true", help="no figures (they need the 'plot' extra)")
     return p
 
@@ -49,7 +51,7 @@ def run(args) -> int:
     fid = twin.run_twin(args.obs, args.nav, out, fit=args.fit, seed=args.seed, reference=reference,
                         reference_source=source, trajectory=args.trajectory,
                         trajectory_solution=args.trajectory_solution, code_model=args.code_model,
-                        realisations=args.realisations)
+                        realisations=args.realisations, shadowing=not args.no_shadowing)
     figures = []
     if not args.no_plots:
         from ..plots import twin_figures

@@ -13,6 +13,7 @@ from ..errors import ScenarioError
 from ..section import Section, in_range, non_negative, positive
 from . import clock, signals
 from .acquisition import AcquisitionConfig, parse_acquisition
+from .shadowing import ShadowingConfig, parse_shadowing
 from .truth_config import TruthErrorsConfig, parse_truth_errors
 
 ERROR_TERMS = ("receiver_clock", "satellite_clock", "group_delay", "ionosphere", "troposphere", "multipath",
@@ -90,6 +91,7 @@ class GnssConfig:
     cn0_offset_db: dict = field(default_factory=dict)  # signal -> dB added to the signal table's C/N0 offset
     truth_errors: TruthErrorsConfig | None = None  # departures of the truth from the receiver's models; None: off
     acquisition: AcquisitionConfig = field(default_factory=AcquisitionConfig)  # rising satellites' first track
+    shadowing: ShadowingConfig | None = None  # stochastic street shadowing / blockage of C/N0; None: off
 
     @property
     def nav_systems(self) -> str:
@@ -137,7 +139,8 @@ def parse_config(sec: Section) -> GnssConfig:
         code_error_scale=_code_scale(sec.section("code_error_scale"), sigs),
         cn0_offset_db=_cn0_offset(sec.section("cn0_offset_db"), sigs),
         truth_errors=parse_truth_errors(sec.section("truth_errors")),
-        acquisition=parse_acquisition(sec.section("acquisition")))
+        acquisition=parse_acquisition(sec.section("acquisition")),
+        shadowing=parse_shadowing(sec.section("shadowing")))
     sec.done()
     return cfg
 

@@ -89,6 +89,8 @@ class GnssTruth:
     los_state: np.ndarray | None = None        # with an [environment]: (M, A, S) uint8, see simkit.environment
     nlos_delay: np.ndarray | None = None       # with an [environment]: (M, A, S) m, extra path of the reflection
     system_time_offset: np.ndarray | None = None  # (M, S) m: -c (system time - GPS time), when one is applied
+    shadow_state: np.ndarray | None = None     # with [gnss.shadowing]: (M, A, S) uint8, see simkit.gnss.shadowing
+    shadow_attenuation: np.ndarray | None = None  # with [gnss.shadowing]: (M, A, S) dB taken off C/N0
 
 
 @dataclass(frozen=True)

@@ -47,6 +47,7 @@ from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
 from .columns import place_columns
 from .orbit_range import range_errors
+from .shadowing import BLOCKED, Shadowing
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
 from .tracking import Tracking
 from .tropo_truth import TruthTroposphere
@@ -65,7 +66,7 @@ _DEFAULT_KLOBUCHAR = {"G": (atmosphere.DEFAULT_GPS_ALPHA, atmosphere.DEFAULT_GPS
 class BlockGeometry:
     """What :meth:`GnssSimulator.geometry` computes for a block of M epochs: times ``t`` (M,) s since the start
     and GPS ``week``/``sow`` (M,), antenna positions and velocities (M, A, 3) ECEF, the body-to-ECEF matrices
-    ``c_be`` (M, 3, 3), the light-time solution ``ref`` at the IMU centre (:meth:`simkit.constellation.Sky.view`),
+    ``c_be`` (M, 3, 3), the IMU centre's ``speed`` (M,) m/s, the light-time solution ``ref`` at the IMU centre (:meth:`simkit.constellation.Sky.view`),
     the candidate satellite columns ``cand`` (C,), their per-antenna ``view``
     (:func:`simkit.constellation.antenna_view`) and the ``atmosphere`` along it."""
 
@@ -75,6 +76,7 @@ class BlockGeometry:
     ant_pos: np.ndarray
     ant_vel: np.ndarray
     c_be: np.ndarray
+    speed: np.ndarray
     ref: dict
     cand: np.ndarray
     view: AntennaView
@@ -130,6 +132,8 @@ class GnssSimulator:
         self.acquisition = Acquisition(cfg.acquisition, self.n_ant, len(self.sat_ids))
         self.nlos = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)   # tracking a reflection only
         self.sat_index = {sid: k for k, sid in enumerate(self.sat_ids)}
+        self.shadowing = None if cfg.shadowing is None else Shadowing(cfg.shadowing, seed, self.sat_ids,
+                                                                       self.n_ant, self.dt)
         self._truth_models(seed)
 
     def _truth_models(self, seed: int) -> None:
@@ -252,12 +256,17 @@ class GnssSimulator:
         ant_pos, ant_vel, c_be = frames.lever_arm_ecef(pos, np.asarray(vel_ecef, dtype=float).reshape(t.size, 3),
                                                        quat_nb, omega_ib_b, self.lever)
         ref = self.sky.view(pos, week, sow, reception_grid=self.cfg.rate_hz * RECEPTION_GRID_S >= 2.0)
-        low = self.cfg.elevation_mask_rad if self.env is None else min(self.cfg.elevation_mask_rad, 0.0)
         with np.errstate(invalid="ignore"):
-            cand = np.flatnonzero((ref["elevation"] >= low - _MASK_MARGIN_RAD).any(axis=0))
+            cand = np.flatnonzero((ref["elevation"] >= self._candidate_floor() - _MASK_MARGIN_RAD).any(axis=0))
         view = antenna_view({k: v[:, cand] for k, v in ref.items()}, ant_pos, ant_vel)
-        return BlockGeometry(t, week, sow, ant_pos, ant_vel, c_be, ref, cand, view,
+        speed = np.linalg.norm(np.asarray(vel_ecef, dtype=float).reshape(t.size, 3), axis=1)
+        return BlockGeometry(t, week, sow, ant_pos, ant_vel, c_be, speed, ref, cand, view,
                              _Atmosphere(self, t, week, sow, cand, view))
+
+    def _candidate_floor(self) -> float:
+        """The elevation (rad) above which a satellite is a candidate column: the mask, or with an environment the
+        horizon (a reflection can be tracked from below the mask)."""
+        return self.cfg.elevation_mask_rad if self.env is None else min(self.cfg.elevation_mask_rad, 0.0)
 
     def observe(self, geo: BlockGeometry) -> GnssEpochs:
         """The rest of :meth:`process`, in block order (clocks, random draws, multipath and tracking carry their
@@ -268,11 +277,18 @@ class GnssSimulator:
             los = self.env.classify(geo.ant_pos, view.lla, view.vel_enu, view.los, view.azimuth, view.elevation,
                                     view.azimuth_rate, view.elevation_rate, geo.c_be)
         vis_c, off = self._visibility(t, view, geo.c_be, cand, los)
-        vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         k0 = int(round(t[0] * self.cfg.rate_hz))
+        shadow = None
+        if self.shadowing is not None:   # street shadowing (simkit.gnss.shadowing): a blocked satellite is not tracked
+            el_c = geo.ref["elevation"][:, cand]
+            with np.errstate(invalid="ignore"):
+                shadow = self.shadowing.advance(k0, el_c, el_c >= self._candidate_floor() - _MASK_MARGIN_RAD,
+                                                geo.speed, cand)
+            vis_c = vis_c & (shadow.state != BLOCKED)
+        vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
         parts = _Parts(self, t, geo.week, geo.sow, cand, view, vis_c, off, draws, geo.ref, geo.ant_vel,
-                       geo.atmosphere, los)
+                       geo.atmosphere, los, shadow)
         return GnssEpochs(t=t, sat_pos_ecef=geo.ref["sat_pos_emission"], sat_clock=geo.ref["sat_clock"],
                           truth=parts.truth(geo.ant_pos, geo.ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
 
@@ -398,8 +414,9 @@ class _Atmosphere:
 class _Parts:
     """The error terms and observables of one block, computed step by step on the candidate columns."""
 
-    def __init__(self, sim: GnssSimulator, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, atmo, los=None):
-        self.sim, self.cand, self.view, self.m, self.los = sim, cand, view, t.size, los
+    def __init__(self, sim: GnssSimulator, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, atmo, los=None,
+                 shadow=None):
+        self.sim, self.cand, self.view, self.m, self.los, self.shadow = sim, cand, view, t.size, los, shadow
         self.t, self.week, self.sow = t, week, sow
         self.shape = (t.size, sim.n_ant, len(sim.sat_ids))
         err = sim.cfg.errors
@@ -494,6 +511,8 @@ class _Parts:
         for a, ant in enumerate(cfg.antennas):
             if ant.gain_pattern is not None:
                 cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern, cn0_off)
+        if self.shadow is not None:
+            cn0 = cn0 - self.shadow.attenuation_db[..., cj]
         freq = sim.freq[cols, j]                                                    # (C,) Hz
         lam = C_LIGHT / freq if g.is_fdma else g.wavelength_m
         sig_c, sig_p, sig_d = (s * err["noise"] for s in sim.sigmas(cn0, g, lam))
@@ -574,4 +593,7 @@ class _Parts:
                          satellite_clock_error=self.sat_clk_error,
                          system_time_offset=self.sys_offset,
                          los_state=None if self.los is None else self.full(self.los.state, 255),
-                         nlos_delay=None if self.los is None else self.full(self.los.extra))
+                         nlos_delay=None if self.los is None else self.full(self.los.extra),
+                         shadow_state=None if self.shadow is None else self.full(self.shadow.state, 255),
+                         shadow_attenuation=None if self.shadow is None else self.full(
+                             np.where(self.shadow.state <= 1, self.shadow.attenuation_db, np.nan)))

@@ -136,6 +136,12 @@ _GNSS = [
     _f("gnss/truth/nlos_delay", "f8", ("M", "A", "S"), "m", "", "gnss",
        "extra path of the received reflection (with an [environment]; states 1 and 2), 0 where direct only, "
        "NaN where blocked or below the horizon"),
+    _f("gnss/truth/shadow_state", "u1", ("M", "A", "S"), "", "", "gnss",
+       "street shadowing channel (with [gnss.shadowing]): 0 line of sight, 1 shadowed, 2 blocked (not tracked), "
+       "255 no chain (below the horizon margin)"),
+    _f("gnss/truth/shadow_attenuation", "f8", ("M", "A", "S"), "dB", "", "gnss",
+       "shadowing attenuation taken off C/N0 (with [gnss.shadowing]): 0 in line of sight, NaN where blocked or "
+       "no chain"),
     _f("gnss/truth/ionosphere_model_error", "f8", ("M", "A", "S"), "m", "", "gnss",
        "truth minus broadcast Klobuchar ionosphere, at L1 (GPS) / B1I (BDS); 0 with truth_errors none"),
     _f("gnss/truth/troposphere_model_error", "f8", ("M", "A", "S"), "m", "", "gnss",

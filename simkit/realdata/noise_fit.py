@@ -208,7 +208,9 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
     :func:`satellite_spread` over sqrt(satellites in the bin)), and the difference twin - real split
     into its bias (mean over bins), scatter (std over bins) and RMS; ``rms_se_dbhz`` the RMS of the differences'
     standard errors (the RMS that sampling alone would give) and ``chi2_per_bin`` the mean squared difference in
-    standard errors (about 1 when the bins differ by sampling only)."""
+    standard errors (about 1 when the bins differ by sampling only); per bin the standard deviation of the C/N0
+    values (real, twin pooled: the spread street shadowing gives) and ``spread_rms_db`` the RMS over the bins of
+    twin - real of it."""
     el_deg = np.degrees(el)
     out = {}
     for s, r in real_cn0.items():
@@ -219,7 +221,7 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
         rr = np.where(np.any(both, axis=0), r, np.nan)
         pooled = np.concatenate([np.where(b, t, np.nan) for b, t in zip(both, twins)], axis=1)
         pel = np.tile(el_deg, (1, len(twins)))
-        rows, diffs, ses = [], [], []
+        rows, diffs, ses, spread = [], [], [], []
         between = satellite_spread(rr, el_deg, edges_deg)
         for lo, hi in zip(edges_deg[:-1], edges_deg[1:]):
             a, b = bin_mean(rr, el_deg, lo, hi), bin_mean(pooled, pel, lo, hi)
@@ -231,16 +233,52 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
             se = float(np.hypot(a["se"], b["se"])) if d is not None else None
             if d is not None:
                 ses.append(se)
+            sd_r = sd_t = None
+            if d is not None:      # the spread of the values within the bin, real and twin
+                sd_r = float(np.nanstd(_in_bin(rr, el_deg, lo, hi)))
+                sd_t = float(np.nanstd(_in_bin(pooled, pel, lo, hi)))
+                spread.append(sd_t - sd_r)
             rows.append({"bin_deg": [float(lo), float(hi)], "real_dbhz": a["mean"], "real_n": a["n"],
                          "real_satellites": a["satellites"], "real_se": a["se"], "twin_dbhz": b["mean"],
-                         "twin_se": b["se"], "difference": d, "difference_se": se})
+                         "twin_se": b["se"], "difference": d, "difference_se": se, "real_sd_db": sd_r,
+                         "twin_sd_db": sd_t})
         d, e = np.array(diffs), np.array(ses)
         out[s] = {"bins": rows, "bias_dbhz": float(d.mean()) if d.size else None,
                   "scatter_dbhz": float(d.std()) if d.size else None,
                   "rms_dbhz": float(np.sqrt(np.mean(d ** 2))) if d.size else None,
                   "rms_se_dbhz": float(np.sqrt(np.mean(e ** 2))) if d.size else None,
-                  "chi2_per_bin": float(np.mean((d / e) ** 2)) if d.size and (e > 0).all() else None}
+                  "chi2_per_bin": float(np.mean((d / e) ** 2)) if d.size and (e > 0).all() else None,
+                  "spread_rms_db": float(np.sqrt(np.mean(np.square(spread)))) if spread else None}
     return out
+
+
+def cn0_drift(bins: list, other_cn0, el_other) -> dict:
+    """The real file's C/N0 against itself: each compared bin of :func:`cn0_comparison` (``bins``, the checked
+    epochs) gets the real mean over the *other* epochs (``other_cn0`` (M', S) dB-Hz, elevations ``el_other`` rad,
+    e.g. the epochs a split fitted on; :func:`bin_mean`), and the differences checked - other over the bins are
+    summarised as the twin's are (bias, scatter, RMS, the RMS of their standard errors, chi-square per bin): the
+    RMS a perfect model of the receiver could not beat on these epochs, the environment having changed."""
+    el_deg = np.degrees(el_other)
+    between = satellite_spread(other_cn0, el_deg, [b["bin_deg"][0] for b in bins] + [bins[-1]["bin_deg"][1]]) \
+        if bins else None
+    diffs, ses = [], []
+    for b in bins:
+        if b["difference"] is None:
+            continue
+        o = bin_mean(other_cn0, el_deg, *b["bin_deg"])
+        if o["se"] is not None and between is not None:
+            o["se"] = max(o["se"], between / np.sqrt(o["satellites"]))
+        b["real_other_dbhz"] = o["mean"]
+        if o["mean"] is None or o["n"] < 10:
+            continue
+        diffs.append(b["real_dbhz"] - o["mean"])
+        ses.append(float(np.hypot(b["real_se"], o["se"])))
+    d, e = np.array(diffs), np.array(ses)
+    if not d.size:
+        return {"bins": 0}
+    return {"bins": int(d.size), "bias_dbhz": float(d.mean()), "scatter_dbhz": float(d.std()),
+            "rms_dbhz": float(np.sqrt(np.mean(d ** 2))), "rms_se_dbhz": float(np.sqrt(np.mean(e ** 2))),
+            "chi2_per_bin": float(np.mean((d / e) ** 2)) if (e > 0).all() else None}
 
 
 def drift(per_signal: dict, other_mp: dict, el_other, tol: float = TOLERANCE) -> dict:

@@ -24,7 +24,7 @@ from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
 from ..gnss.config import code_scale_at
-from . import acquisition, fidelity, horizon, importer, ionosphere, noise_fit, sisre
+from . import acquisition, fidelity, horizon, importer, ionosphere, noise_fit, shadowing_fit, sisre
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
 # simkit's [gnss] defaults that the fit changes (docs/gnss.md)
@@ -114,7 +114,8 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                                          if p.get("iono_residual_fraction") is not None else {}),
                                       **p.get("truth_errors", {})}}
                     if p.get("iono_residual_fraction") is not None or p.get("truth_errors") else {}),
-                 **({"acquisition": dict(p["acquisition"])} if p.get("acquisition") else {})},
+                 **({"acquisition": dict(p["acquisition"])} if p.get("acquisition") else {}),
+                 **({"shadowing": dict(p["shadowing"])} if p.get("shadowing") else {})},
         **({"environment": {"reflections": False, "body_mask": [dict(p["horizon_mask"])]}}
            if p.get("horizon_mask") else {}),
     }
@@ -316,9 +317,14 @@ def _gain_pattern(real, sigs, el, p) -> tuple:
     signal's offset over the bin, minus the fitted zenith C/N0; a bin without ``fidelity.by_elevation``'s
     minimum count takes the quadratic rolloff at its centre. Steps, not a line through the bins' centres: the
     satellites of a short file sit anywhere in their bin, and the comparison is per bin."""
-    edges = fidelity.ELEVATION_EDGES_DEG
     pooled = np.concatenate([real["obs"]["cn0"][g.name] - _cn0_offset(g, p) for g in sigs], axis=1)
-    mean = fidelity.by_elevation(pooled, np.tile(el, (1, len(sigs))))
+    return _pattern(fidelity.by_elevation(pooled, np.tile(el, (1, len(sigs)))), p)
+
+
+def _pattern(mean, p) -> tuple:
+    """The step gain pattern of :func:`_gain_pattern` from C/N0 levels per 10-degree bin ``mean`` (None: the
+    quadratic rolloff at the bin's centre)."""
+    edges = fidelity.ELEVATION_EDGES_DEG
     off, gain = [], []
     for lo, hi, m in reversed(list(zip(edges[:-1], edges[1:], mean))):
         g = m - p["cn0_zenith_dbhz"] if m is not None else -p["rolloff_db"] * ((90.0 - 0.5 * (lo + hi)) / 90.0) ** 2
@@ -428,6 +434,13 @@ def toml_fragment(p: dict) -> str:
             lines += ["", "[gnss.truth_errors]"]
         lines += ["# broadcast orbit/clock (SISRE) and troposphere from ionosphere-free code residuals (sisre.py)"]
         lines += [f"{k} = {_toml_value(v)}" for k, v in p["truth_errors"].items()]
+    if p.get("shadowing"):
+        sh = p["shadowing"]
+        lines += ["", "# street shadowing: a Markov channel per satellite (line of sight / shadowed / blocked) from the "
+                  "real C/N0 series (shadowing_fit.py)", "[gnss.shadowing]"]
+        lines += [f"{k} = {_toml_list(v)}" for k, v in sh.items() if k != "systems"]
+        for letter, table in sh.get("systems", {}).items():
+            lines += [f"[gnss.shadowing.systems.{letter}]", *(f"{k} = {_toml_list(v)}" for k, v in table.items())]
     if p.get("acquisition"):
         lines += ["", "# rising satellites: first tracked this long after they cross the mask (acquisition.py)",
                   "[gnss.acquisition]", f"delay_s = {p['acquisition']['delay_s']:.1f}"]
@@ -438,6 +451,10 @@ def toml_fragment(p: dict) -> str:
                   f"azimuth_deg = [{', '.join(f'{a:g}' for a in tab['azimuth_deg'])}]",
                   f"elevation_deg = [{', '.join(f'{e:g}' for e in tab['elevation_deg'])}]"]
     return "\n".join(lines) + "\n"
+
+
+def _toml_list(v) -> str:
+    return "[" + ", ".join(f"{x:g}" for x in v) + "]" if isinstance(v, list) else _toml_value(v)
 
 
 def _toml_value(v) -> str:
@@ -524,7 +541,7 @@ CODE_MODELS = ("smooth", "bins")
 
 
 def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None, code_model="smooth",
-               realisations=REALISATIONS):
+               realisations=REALISATIONS, shadowing=True):
     """The fitted parameters of ``real`` (:func:`fit_parameters`, the horizon profile, then the carrier, Doppler
     and code terms scaled from a default and a first calibrated twin), the fit's notes and {"horizon":
     :func:`fit_horizon`, "ionosphere": the Klobuchar comparison of :func:`.ionosphere.klobuchar_ratio`};
@@ -549,6 +566,16 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None, c
     acq = fit_acquisition(default[1], default[2], ref, mask, hz["table"] if hz else None)
     if acq["delay_s"] > 0:
         fitted["acquisition"] = {"delay_s": acq["delay_s"]}
+    shadow = fit_shadowing(default[1], default[2], ref, fitted) if shadowing and real.get("trajectory") else None
+    if shadow is not None:           # a drive: the line-of-sight pattern, and the street's losses as a channel
+        fitted["shadowing"] = shadow["config"]
+        shift = shadow["los_offset_db"]
+        first = [k for k in real["signals"] if k in shift and k not in fitted.get("cn0_offset_db", {})]
+        ref_shift = shift[first[0]] if first else 0.0     # the first signal carries no fitted offset
+        fitted["cn0_offset_db"] = {k: v + shift.get(k, ref_shift) - ref_shift
+                                   for k, v in fitted.get("cn0_offset_db", {}).items()}
+        fitted["gain_pattern"] = _pattern([None if v is None else v + ref_shift for v in shadow["level_dbhz"]],
+                                          fitted)
     code_fit = dict(fitted.get("code_error_scale", {}))
     fitted = rescale(fitted, default[0])              # carrier and Doppler terms from the default twin
     if code_model == "bins":
@@ -568,7 +595,19 @@ def _calibrate(real, ref, nav_paths, mask, seed, path, progress, default=None, c
         tables = noise_fit.smooth_correction(code, fitted.get("code_error_scale", {}))
         fitted = rescale(fitted, first)
         fitted["code_error_scale"] = {**fitted["code_error_scale"], **tables}
-    return fitted, notes, {"horizon": hz, "ionosphere": iono, "sisre_troposphere": range_errors, "acquisition": acq}
+    return fitted, notes, {"horizon": hz, "ionosphere": iono, "sisre_troposphere": range_errors, "acquisition": acq,
+                           "shadowing": shadow}
+
+
+def fit_shadowing(real_on_grid: dict, twin: dict, reference, p: dict) -> dict | None:
+    """The street-shadowing channel (:mod:`.shadowing_fit`) of the real C/N0 on the twin's grid, above the mask
+    where the default twin ``twin`` tracks, with the signals' C/N0 offsets of the fitted parameters ``p``."""
+    el = fidelity.elevations(twin["sat_pos"], reference)
+    dt = float(np.median(np.diff(twin["t"]))) if twin["t"].size > 1 else 1.0
+    offsets = {s: _cn0_offset(sigmod.get(s), p) for s in real_on_grid["signals"]}
+    # one state-probability table for all systems: tables per system (shadowing_fit.fit's ``systems``) did not bring
+    # GLONASS closer on Berlin and took it further on its 12 s test copy (docs/shadowing.md)
+    return shadowing_fit.fit(real_on_grid["obs"]["cn0"], offsets, el, fidelity.tracked(twin["obs"]), dt)
 
 
 def _rows(arr: dict, rows) -> dict:
@@ -599,13 +638,13 @@ def split_rows(t, kind: str):
 
 
 def _holdout(real, ref, nav_paths, mask, seed, path, progress, split="half", code_model="smooth",
-             realisations=REALISATIONS) -> dict:
+             realisations=REALISATIONS, shadowing=True) -> dict:
     """Out-of-sample check of the fit: every parameter (horizon profile and code tables included) fitted on the
     epochs :func:`split_rows` keeps, twins of the whole span run with them (``realisations`` seeds), and the
     comparison on the other epochs (neither the fit nor its twins saw them)."""
     fit_rows = split_rows(real["t"], split)
     fitted, _, extras = _calibrate(_rows(real, fit_rows), ref, nav_paths, mask, seed + 10, path, progress,
-                                   code_model=code_model, realisations=realisations)
+                                   code_model=code_model, realisations=realisations, shadowing=shadowing)
     grid, twins = _realisations(real, ref, nav_paths, mask, fitted,
                                 [seed + 12 + 100 * k for k in range(realisations)], path, progress)
     check = ~fit_rows[np.clip(_align(real, twins[0])[1], 0, None)]
@@ -621,6 +660,7 @@ def _holdout(real, ref, nav_paths, mask, seed, path, progress, split="half", cod
             "cn0_rms_difference_dbhz": out["cn0_rms_difference_dbhz"],
             "twin_code_noise_m": out["twin"]["code_noise_m"], "horizon_table": (extras["horizon"] or {}).get("table"),
             "iono_residual_fraction": fitted.get("iono_residual_fraction"),
+            "shadowing": fitted.get("shadowing"),
             "noise": _with_drift(noise_check(grid, twins, ref, mask, rows=check), _rows(grid, ~check), ref)}
 
 
@@ -630,6 +670,8 @@ def _with_drift(check: dict, other: dict, ref) -> dict:
     mp = fidelity.multipath(other["obs"], other["signals"], np.asarray(other["sat_freq"]), other["t"])
     el = fidelity.elevations(other["sat_pos"], ref)
     check["code_noise"]["real_drift"] = noise_fit.drift(check["code_noise"]["signals"], mp, el)
+    for s, c in check["cn0"].items():
+        c["real_against_itself"] = noise_fit.cn0_drift(c["bins"], other["obs"]["cn0"][s], el)
     return check
 
 
@@ -664,12 +706,13 @@ def level_track_csv(rec, centre, name: str) -> str:
                       "gps_week,gps_sow,lat_deg,lon_deg,h_m,sd_e_m,sd_n_m,sd_u_m", *rows]) + "\n"
 
 
-def _fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress, default, code_model, realisations) -> dict:
+def _fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress, default, code_model, realisations,
+                   shadowing=True) -> dict:
     """--fit of :func:`run_twin`: the calibrated twin (fitted.toml, twin_fit.h5), its comparison and noise checks in
     sample, and the two out-of-sample splits; the entries of the fidelity dict."""
     result = {}
     fitted, notes, extras = _calibrate(real, ref, nav_paths, mask, seed, out_dir / "twin_fit.h5", progress,
-                                       default, code_model, realisations)
+                                       default, code_model, realisations, shadowing)
     result.update(extras)
     result["fit_notes"] = notes
     result["fitted_parameters"] = fitted
@@ -682,15 +725,15 @@ def _fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress, default,
     result["noise"] = {"in_sample": noise_check(grid, twins, ref, mask), "code_model": code_model,
                        "twin_realisations": realisations}
     result["holdout"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5", progress,
-                                 "half", code_model, realisations)
+                                 "half", code_model, realisations, shadowing)
     result["holdout_interleaved"] = _holdout(real, ref, nav_paths, mask, seed, out_dir / "twin_holdout.h5",
-                                             progress, "interleaved", code_model, realisations)
+                                             progress, "interleaved", code_model, realisations, shadowing)
     return result
 
 
 def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, reference=None,
              reference_source=None, progress: bool = False, trajectory=None, trajectory_solution=None,
-             code_model: str = "smooth", realisations: int = REALISATIONS) -> dict:
+             code_model: str = "smooth", realisations: int = REALISATIONS, shadowing: bool = True) -> dict:
     """Import ``obs_path`` (+ ``nav_paths``), simulate its twin into ``out_dir``/twin.h5 (and with ``fit`` the
     calibrated twin_fit.h5), compare; returns the fidelity dict (also the content of fidelity.json).
 
@@ -701,7 +744,9 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
 
     ``code_model`` and ``realisations``: :func:`_calibrate`'s; the calibrated twin is checked in sample and out of
     sample on both :data:`SPLITS` (``holdout``: half, ``holdout_interleaved``) over ``realisations`` seeds
-    (:func:`noise_check`)."""
+    (:func:`noise_check`). ``shadowing``: with a ``trajectory``, fit the street-shadowing channel
+    (:func:`fit_shadowing`, ``[gnss.shadowing]``) into the calibrated twin; False keeps the C/N0 an elevation
+    model only."""
     out_dir = Path(out_dir)
     if not nav_paths:
         raise InputError("--nav", "the twin needs the broadcast navigation file(s) of the observation file")
@@ -733,8 +778,14 @@ def run_twin(obs_path, nav_paths, out_dir, fit: bool = False, seed: int = 1, ref
     result["default"], real_grid, twin0 = _twin_once(real, ref, nav_paths, mask, DEFAULTS, seed,
                                                       out_dir / "twin.h5", progress, arrays=True)
     if fit:
-        result.update(_fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress,
-                                     (result["default"], real_grid, twin0), code_model, realisations))
+        default = (result["default"], real_grid, twin0)
+        result.update(_fit_and_check(real, ref, nav_paths, mask, seed, out_dir, progress, default, code_model,
+                                     realisations, shadowing))
+        if shadowing and result.get("shadowing"):      # the same checks without the term, side by side in report.md
+            sub = out_dir / "without_shadowing"
+            sub.mkdir(exist_ok=True)
+            result["without_shadowing"] = _fit_and_check(real, ref, nav_paths, mask, seed, sub, progress, default,
+                                                         code_model, realisations, False)
     (out_dir / "fidelity.json").write_text(json.dumps(result, indent=1))
     return result
 
@@ -789,6 +840,16 @@ def report_markdown(fid: dict, figures=()) -> str:
         out += ["", "## Fitted [gnss] parameters", "", "```toml", toml_fragment(fid["fitted_parameters"]).rstrip(),
                 "```"] + [f"- {n}" for n in fid.get("fit_notes", [])]
     out += sisre.report_lines(fid.get("sisre_troposphere")) + acquisition.report_lines(fid.get("acquisition"))
+    out += shadowing_markdown(fid)
+    sh = fid.get("shadowing")
+    if sh:
+        c = sh["config"]
+        out += ["", "## Street shadowing (fitted)", "",
+                f"Satellite-epochs above the mask: {sh['state_counts'][0]} line of sight, {sh['state_counts'][1]} "
+                f"shadowed, {sh['state_counts'][2]} blocked; mean dwell (s) {', '.join(f'{d:.1f}' for d in c['dwell_s'])}"
+                f"; attenuation {c['attenuation_mean_db']:.1f} ± {c['attenuation_sigma_db']:.1f} dB, correlation "
+                f"{c['attenuation_correlation_s']:.1f} s; line-of-sight C/N0 spread {sh['los_sd_db']:.1f} dB "
+                "(not simulated: the twin's C/N0 is noiseless)."]
     out += [""] + [f"![{Path(p).stem}]({Path(p).name})" for p in figures]
     return "\n".join(out) + "\n"
 
@@ -843,16 +904,70 @@ def noise_markdown(fid: dict) -> list:
                            f"{b['real_n']} / {b['real_n_eff']:.0f} | {_fmt(b['twin_m'], 3)} | {_fmt(b['ratio'])} | "
                            f"{_fmt(b['ratio_rel_se'])} |")
         for sig, c in sec["cn0"].items():
-            out += ["", f"C/N0 {sig}: bias {_fmt(c['bias_dbhz'])}, scatter {_fmt(c['scatter_dbhz'])}, RMS "
-                    f"{_fmt(c['rms_dbhz'])} dB-Hz over the bins (sampling alone: {_fmt(c['rms_se_dbhz'])}; chi-square "
-                    f"per bin {_fmt(c['chi2_per_bin'])})", "",
-                    "| elevation (deg) | real (dB-Hz) | satellites | twin | twin - real | ± |", "|---|---:|---:|---:|---:|---:|"]
+            out += ["", f"C/N0 {sig}: {_cn0_summary(c, ' over the bins')}" + _cn0_drift_line(c.get("real_against_itself"))
+                    + f". Spread within the bins (standard deviation of C/N0), twin - real: RMS "
+                    f"{_fmt(c.get('spread_rms_db'))} dB", "",
+                    "| elevation (deg) | real (dB-Hz) | satellites | twin | twin - real | ± | real sd | twin sd |",
+                    "|---|---:|---:|---:|---:|---:|---:|---:|"]
             for b in c["bins"]:
                 if b["difference"] is not None:
                     out.append(f"| {b['bin_deg'][0]:g}-{b['bin_deg'][1]:g} | {_fmt(b['real_dbhz'], 1)} | "
                                f"{b['real_satellites']} | {_fmt(b['twin_dbhz'], 1)} | {_fmt(b['difference'], 1)} | "
-                               f"{_fmt(b['difference_se'], 1)} |")
+                               f"{_fmt(b['difference_se'], 1)} | {_fmt(b.get('real_sd_db'), 1)} | "
+                               f"{_fmt(b.get('twin_sd_db'), 1)} |")
     return out
+
+
+def _cn0_rows(fid: dict) -> dict:
+    """{(comparison, signal): (C/N0 comparison, visibility agreement)} of a fitted twin's noise checks."""
+    out = {}
+    for title, sec in _noise_sections(fid):
+        key = title.split(" (")[0]
+        vis = fid["fitted"] if key == "in sample" else next(
+            fid[k] for k in ("holdout", "holdout_interleaved") if fid.get(k, {}).get("noise") is sec)
+        for sig, c in sec["cn0"].items():
+            out[(key, sig)] = (c, vis["visibility_agreement"])
+    return out
+
+
+def shadowing_markdown(fid: dict) -> list:
+    """report.md's table of the C/N0 comparisons with and without the street-shadowing term (docs/shadowing.md),
+    with the real file against itself beside: RMS over the bins of the bin means (chi-square per bin), RMS of the
+    spreads within the bins, visibility agreement."""
+    if "without_shadowing" not in fid:
+        return []
+    on, off = _cn0_rows(fid), _cn0_rows(fid["without_shadowing"])
+    out = ["", "## C/N0 with and without the street-shadowing term", "",
+           "RMS over the 10-degree bins of twin - real bin means (chi-square per bin), and of the C/N0 spreads within "
+           "the bins; the real file against itself on the splits (docs/shadowing.md).", "",
+           "| comparison | signal | without: means | spread | visibility | with: means | spread | visibility | "
+           "real against itself |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+
+    def cell(c):
+        return f"{_fmt(c['rms_dbhz'])} ({_fmt(c['chi2_per_bin'])})"
+
+    for key, (c_on, v_on) in on.items():
+        if key not in off:
+            continue
+        c_off, v_off = off[key]
+        rr = c_on.get("real_against_itself") or {}
+        out.append(f"| {key[0]} | {key[1]} | {cell(c_off)} | {_fmt(c_off.get('spread_rms_db'))} | "
+                   f"{_fmt(100 * v_off, 1)} % | {cell(c_on)} | {_fmt(c_on.get('spread_rms_db'))} | "
+                   f"{_fmt(100 * v_on, 1)} % | {cell(rr) if rr.get('bins') else '-'} |")
+    return out
+
+
+def _cn0_drift_line(d) -> str:
+    if not d or not d.get("bins"):
+        return ""
+    return ("; the real file against itself (its bin means here minus those on the epochs fitted on, same bins): "
+            + _cn0_summary(d))
+
+
+def _cn0_summary(c, where: str = "") -> str:
+    """Bias, scatter and RMS of a C/N0 comparison with the RMS of sampling alone and chi-square per bin."""
+    return (f"bias {_fmt(c['bias_dbhz'])}, scatter {_fmt(c['scatter_dbhz'])}, RMS {_fmt(c['rms_dbhz'])} dB-Hz{where} "
+            f"(sampling alone: {_fmt(c['rms_se_dbhz'])}; chi-square per bin {_fmt(c['chi2_per_bin'])})")
 
 
 def _within(ratios: dict, tol: float = 0.2) -> str:
