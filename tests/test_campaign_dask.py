@@ -159,7 +159,7 @@ def test_ctrl_c_on_a_campaign_is_one_line(tmp_path):
         os.chdir(tmp_path)
         os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
         os.execv(sys.executable, [sys.executable, "-m", "simkit", "campaign", "quickstart", "--runs", "8", "-o",
-                                  "c", "--set", "scenario.duration_s=7200"])   # ~30 s of work: still running
+                                  "c", "--set", "scenario.duration_s=28800"])   # ~30 s of work: still running
     try:
         deadline = time.monotonic() + 90
         while not (tmp_path / "c" / "runs").is_dir() and time.monotonic() < deadline:
