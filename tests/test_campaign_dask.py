@@ -156,6 +156,9 @@ def test_ctrl_c_on_a_campaign_is_one_line(tmp_path):
 
     pid, fd = pty.fork()
     if pid == 0:  # the child: a real terminal is its controlling tty
+        # as an interactive shell starts a command: a job started with & by a non-interactive shell (a CI script)
+        # inherits SIGINT ignored, and Python then never turns Ctrl-C into KeyboardInterrupt
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
         os.chdir(tmp_path)
         os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
         os.execv(sys.executable, [sys.executable, "-m", "simkit", "campaign", "quickstart", "--runs", "8", "-o",
