@@ -201,6 +201,9 @@ def test_the_fitted_fragment_is_a_valid_gnss_section(tmp_path):
     sc["gnss"]["code_error_scale"] = fragment["gnss"]["code_error_scale"]
     sc["gnss"]["signals"] = ["L1C", "L2W"]
     assert load(sc).gnss.code_error_scale == tables
+    # the same parameters read back from fidelity.json (tuples become lists) give the same fragment
+    as_json = json.loads(json.dumps(dict(twin.DEFAULTS, code_error_scale=tables)))
+    assert twin.toml_fragment(as_json) == twin.toml_fragment(dict(twin.DEFAULTS, code_error_scale=tables))
     assert loaded.gnss.multipath.carrier_sigma_m == pytest.approx(0.01)
 
 

@@ -105,7 +105,8 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                            "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
                  "cn0_offset_db": dict(p.get("cn0_offset_db", {})),
                  "code_error_scale": {k: {"elevation_deg": list(v[0]), "factor": list(v[1])}
-                                      if isinstance(v, tuple) else v for k, v in p.get("code_error_scale", {}).items()},
+                                      if isinstance(v, (tuple, list)) else v
+                                      for k, v in p.get("code_error_scale", {}).items()},
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
                                "correlation_time_s": p["mp_correlation_time_s"],
@@ -466,7 +467,7 @@ def _toml_value(v) -> str:
 
 
 def _scale_toml(v) -> str:
-    if isinstance(v, tuple):
+    if isinstance(v, (tuple, list)):   # (elevation_deg, factor); a list of two lists when read back from JSON
         return (f"{{elevation_deg = [{', '.join(f'{e:g}' for e in v[0])}], "
                 f"factor = [{', '.join(f'{f:.4f}' for f in v[1])}]}}")
     return f"{v:.4f}"
