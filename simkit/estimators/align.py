@@ -33,8 +33,13 @@ def static_alignment(gyro, accel, lat, gyro_bias_sigma=0.0):
     pitch = np.arcsin(np.clip(c[2, 1], -1, 1))
     roll = np.arctan2(-c[2, 0], c[2, 2])
     heading = wrap_2pi(np.arctan2(c[0, 1], c[1, 1]))
-    sigma = np.arctan2(gyro_bias_sigma, OMEGA_E * np.cos(lat))
-    return np.array([pitch, roll, heading]), float(sigma)
+    return np.array([pitch, roll, heading]), gyrocompass_heading_sigma(gyro_bias_sigma, lat)
+
+
+def gyrocompass_heading_sigma(gyro_sigma, lat) -> float:
+    """Heading sigma (rad) of gyrocompassing with a gyro error ``gyro_sigma`` rad/s (bias, noise over the span) at
+    latitude ``lat`` rad: that error read as a tilt of the horizontal Earth rate Omega_e cos(lat)."""
+    return float(np.arctan2(gyro_sigma, OMEGA_E * np.cos(lat)))
 
 
 def motion_alignment(vel_enu):

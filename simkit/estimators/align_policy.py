@@ -7,9 +7,8 @@ import numpy as np
 
 from ..frames import ecef_to_lla, quat_from_euler
 from ..io import n_antennas
-from ..earth import OMEGA_E
 from .adapter import filter_config, solved_attitude
-from .align import motion_alignment, static_alignment
+from .align import gyrocompass_heading_sigma, motion_alignment, static_alignment
 from .errors import EstimatorInputError
 from .inputs import GnssFixes, ImuData, InitialState
 from .truth_inputs import truth_start
@@ -43,7 +42,7 @@ def gyrocompass_sigma(ds, p, lat: float) -> float:
     well under a degree."""
     cfg = filter_config(ds, p, None)
     noise = np.hypot(cfg.p0_gyro_bias, cfg.gyro_arw / np.sqrt(max(float(p["align_static_s"]), 1e-3)))
-    return float(np.arctan2(noise, OMEGA_E * np.cos(lat)))
+    return gyrocompass_heading_sigma(noise, lat)
 
 
 def _static_start(p, imu: ImuData, lla_ant):

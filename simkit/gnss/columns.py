@@ -37,3 +37,11 @@ def place_columns(x, cols, n_cols: int, keep=None, fill: float = np.nan) -> np.n
     else:
         _place(x, cols, np.ascontiguousarray(keep, dtype=np.bool_), True, float(fill), out)
     return out
+
+
+def consecutive(idx: np.ndarray):
+    """The indices ``idx`` (K,) as a slice when they are consecutive and increasing (indexing with it gives views,
+    not copies), else ``idx`` itself."""
+    if idx.size and np.all(np.diff(idx) == 1):
+        return slice(int(idx[0]), int(idx[-1]) + 1)
+    return idx

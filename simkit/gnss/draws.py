@@ -15,6 +15,7 @@ import numba
 import numpy as np
 
 from .. import rng
+from .columns import consecutive
 
 DRAWS_PER_SIGNAL = 5  # code, carrier, Doppler, multipath code, multipath carrier
 _HALF_ULP = 2.0**-54   # maps PCG64's k / 2^53 doubles into the open interval (0, 1)
@@ -98,9 +99,8 @@ class KeyedNormals:
         buf = np.empty(m * self.n_signals * DRAWS_PER_SIGNAL)
         for c, s in enumerate(cols):
             sigs = self.signals_of_sat[s]
-            if sigs.size and sigs[-1] - sigs[0] + 1 == sigs.size:   # consecutive signals: write through a view
-                sigs = slice(int(sigs[0]), int(sigs[-1]) + 1)
-            per_epoch = (out[0, 0, 0, sigs, 0].size) * DRAWS_PER_SIGNAL
+            per_epoch = sigs.size * DRAWS_PER_SIGNAL
+            view = consecutive(sigs)   # consecutive signals: written through a view
             for a in range(n_ant):
                 gen = self.streams[a][s]
                 skip = k0 * per_epoch - self.position[a, s]
@@ -108,8 +108,8 @@ class KeyedNormals:
                     raise ValueError(f"epochs must be drawn in order (epoch {k0} after {self.position[a, s]})")
                 gen.bit_generator.advance(int(skip))
                 u = gen.random(out=buf[:m * per_epoch])
-                if isinstance(sigs, slice):
-                    _quantiles(u, _HALF_ULP, out[:, a, c, sigs])
+                if isinstance(view, slice):
+                    _quantiles(u, _HALF_ULP, out[:, a, c, view])
                 else:
                     out[:, a, c, sigs] = normal_quantiles(u + _HALF_ULP).reshape(m, sigs.size, DRAWS_PER_SIGNAL)
                 self.position[a, s] = (k0 + m) * per_epoch

@@ -45,7 +45,7 @@ from .ionex import read_ionex
 from .iono_steps import klobuchar_delays
 from .iono_truth import TruthIonosphere
 from .multipath import elevation_scale, multipath_bank
-from .columns import place_columns
+from .columns import consecutive, place_columns
 from .orbit_range import range_errors
 from .shadowing import BLOCKED, Shadowing
 from .observables import GnssEpochs, GnssStatic, GnssTruth, SignalObs, SignalTruth
@@ -66,9 +66,9 @@ _DEFAULT_KLOBUCHAR = {"G": (atmosphere.DEFAULT_GPS_ALPHA, atmosphere.DEFAULT_GPS
 class BlockGeometry:
     """What :meth:`GnssSimulator.geometry` computes for a block of M epochs: times ``t`` (M,) s since the start
     and GPS ``week``/``sow`` (M,), antenna positions and velocities (M, A, 3) ECEF, the body-to-ECEF matrices
-    ``c_be`` (M, 3, 3), the IMU centre's ``speed`` (M,) m/s, the light-time solution ``ref`` at the IMU centre (:meth:`simkit.constellation.Sky.view`),
-    the candidate satellite columns ``cand`` (C,), their per-antenna ``view``
-    (:func:`simkit.constellation.antenna_view`) and the ``atmosphere`` along it."""
+    ``c_be`` (M, 3, 3), the IMU centre's ``speed`` (M,) m/s, the light-time solution ``ref`` at the IMU centre
+    (:meth:`simkit.constellation.Sky.view`), the candidate satellite columns ``cand`` (C,), their per-antenna
+    ``view`` (:func:`simkit.constellation.antenna_view`) and the ``atmosphere`` along it."""
 
     t: np.ndarray
     week: np.ndarray
@@ -257,16 +257,17 @@ class GnssSimulator:
                                                        quat_nb, omega_ib_b, self.lever)
         ref = self.sky.view(pos, week, sow, reception_grid=self.cfg.rate_hz * RECEPTION_GRID_S >= 2.0)
         with np.errstate(invalid="ignore"):
-            cand = np.flatnonzero((ref["elevation"] >= self._candidate_floor() - _MASK_MARGIN_RAD).any(axis=0))
+            cand = np.flatnonzero((ref["elevation"] >= self._candidate_floor()).any(axis=0))
         view = antenna_view({k: v[:, cand] for k, v in ref.items()}, ant_pos, ant_vel)
         speed = np.linalg.norm(np.asarray(vel_ecef, dtype=float).reshape(t.size, 3), axis=1)
         return BlockGeometry(t, week, sow, ant_pos, ant_vel, c_be, speed, ref, cand, view,
                              _Atmosphere(self, t, week, sow, cand, view))
 
     def _candidate_floor(self) -> float:
-        """The elevation (rad) above which a satellite is a candidate column: the mask, or with an environment the
-        horizon (a reflection can be tracked from below the mask)."""
-        return self.cfg.elevation_mask_rad if self.env is None else min(self.cfg.elevation_mask_rad, 0.0)
+        """The elevation (rad) at the IMU centre from which a satellite is a candidate column: the mask, or with an
+        environment the horizon (a reflection can be tracked from below the mask), less the antennas' margin."""
+        low = self.cfg.elevation_mask_rad if self.env is None else min(self.cfg.elevation_mask_rad, 0.0)
+        return low - _MASK_MARGIN_RAD
 
     def observe(self, geo: BlockGeometry) -> GnssEpochs:
         """The rest of :meth:`process`, in block order (clocks, random draws, multipath and tracking carry their
@@ -282,7 +283,7 @@ class GnssSimulator:
         if self.shadowing is not None:   # street shadowing (simkit.gnss.shadowing): a blocked satellite is not tracked
             el_c = geo.ref["elevation"][:, cand]
             with np.errstate(invalid="ignore"):
-                shadow = self.shadowing.advance(k0, el_c, el_c >= self._candidate_floor() - _MASK_MARGIN_RAD,
+                shadow = self.shadowing.advance(k0, el_c, el_c >= self._candidate_floor(),
                                                 geo.speed, cand)
             vis_c = vis_c & (shadow.state != BLOCKED)
         vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
@@ -503,8 +504,7 @@ class _Parts:
         sim, cfg, err = self.sim, self.sim.cfg, self.sim.cfg.errors
         cj = np.flatnonzero(sim.carries[self.cand, j])
         cols = self.cand[cj]
-        if cj.size and cj[-1] - cj[0] + 1 == cj.size:  # one system's columns, consecutive: views, not copies
-            cj = slice(int(cj[0]), int(cj[-1]) + 1)
+        cj = consecutive(cj)   # one system's columns: views, not copies
         rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
         cn0_off = g.cn0_offset_db + cfg.cn0_offset_db.get(g.name, 0.0)
         cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, cn0_off)
