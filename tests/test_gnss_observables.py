@@ -275,3 +275,12 @@ def test_each_signal_has_its_multipath_correlation_time():
         pair = np.isfinite(u[1:]) & np.isfinite(u[:-1])
         r = np.sum(u[1:][pair] * u[:-1][pair]) / np.sqrt(np.sum(u[1:][pair] ** 2) * np.sum(u[:-1][pair] ** 2))
         assert r == pytest.approx(np.exp(-1.0 / tau), abs=0.03), sig
+
+
+@pytest.mark.parametrize("table, key, words", [({"L5Q": 3.0}, "L5Q", "unknown key"),
+                                               ({"L1C": -1.0}, "L1C", "must be > 0"),
+                                               ({"L1C": "long"}, "L1C", "expected")])
+def test_a_bad_signal_correlation_time_is_one_error_naming_the_key(table, key, words):
+    with pytest.raises(ScenarioError) as e:
+        make({"multipath": {"signal_correlation_time_s": table}})
+    assert f"gnss.multipath.signal_correlation_time_s.{key}" in str(e.value) and words in str(e.value)
