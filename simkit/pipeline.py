@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 from collections import deque
+from contextlib import contextmanager
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -68,10 +69,13 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
                           f" GiB; scenario.duration_s = {sc.duration_s:g}); --force to run it anyway")
     source = None if isinstance(scenario, dict) else _scenario_file(scenario)
     check_output(out, inputs=[source], estimated_bytes=size, force=force, simkit_only=True)
-    stages = build(sc, sky)
     threads = compression_threads() if threads is None else threads
-    with Writer(out, root_attributes(sc), threads) as w:
-        _write(w, sc, stages, block_samples, progress, ahead=threads > 1)
+    traj = Trajectory(sc.trajectory, sc.duration_s)
+    # the truth starts now, on its worker, while the IMU and GNSS stages are built and h5py loads
+    with _truth_lane(traj.blocks(block_samples=block_samples), ahead=threads > 1) as truth:
+        stages = build(sc, sky, traj)
+        with Writer(out, root_attributes(sc), threads) as w:
+            _write(w, sc, stages, truth, progress, ahead=threads > 1)
     return out
 
 
@@ -110,10 +114,10 @@ def toml_literal(key: str, value) -> str:
                             f"{value!r}") from None
 
 
-def build(sc: Scenario, sky: Sky | None = None) -> Stages:
+def build(sc: Scenario, sky: Sky | None = None, traj: Trajectory | None = None) -> Stages:
     """The stages of scenario ``sc``; ``sky`` (loaded from ``sc.gnss`` when not given) is first checked to
-    cover the run."""
-    traj = Trajectory(sc.trajectory, sc.duration_s)
+    cover the run; ``traj``: the scenario's trajectory when already made."""
+    traj = traj if traj is not None else Trajectory(sc.trajectory, sc.duration_s)
     imu = ImuSimulator(sc.imu, sc.trajectory.rate_hz, sc.seed) if sc.imu is not None else None
     gnss = None
     if sc.gnss is not None:
@@ -235,27 +239,32 @@ def _write_static(w: Writer, sc: Scenario, stages: Stages) -> None:
             w.write(path, data)
 
 
-def _truth_ahead(blocks: Iterator, ahead: bool, depth: int = TRUTH_AHEAD) -> Iterator:
-    """The truth blocks, computed on a worker thread up to ``depth`` blocks ahead of the caller (numpy releases the
-    GIL in its loops, so the truth, the IMU + writes and the compression share the cores; one block ahead left the
-    worker idle while the caller waited for the compression); in order, as computed alone. ``ahead`` False: on the
-    calling thread."""
+@contextmanager
+def _truth_lane(blocks: Iterator, ahead: bool, depth: int = TRUTH_AHEAD) -> Iterator[Iterator]:
+    """The truth blocks as an iterator, computed on a worker thread from the moment the context opens and up to
+    ``depth`` blocks ahead of the reader (numpy releases the GIL in its loops, so the truth, the IMU + writes and
+    the compression share the cores; one block ahead left the worker idle while the reader waited for the
+    compression); in order, as computed alone. ``ahead`` False: computed by the reader, on its thread."""
     if not ahead:
-        yield from blocks
+        yield blocks
         return
     worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="simkit-truth")  # one thread: in order
-    try:
-        queued = deque(worker.submit(next, blocks, None) for _ in range(depth))
+    queued = deque(worker.submit(next, blocks, None) for _ in range(depth))
+
+    def read() -> Iterator:
         while (block := queued.popleft().result()) is not None:
             queued.append(worker.submit(next, blocks, None))
             yield block
+
+    try:
+        yield read()
     finally:
         worker.shutdown(wait=True, cancel_futures=True)
 
 
-def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress: bool, ahead: bool = False) -> None:
-    """Every block of the run into ``w``: truth and IMU rows per truth block, then the GNSS epochs of each block
-    (``ahead``: the truth and the next GNSS slice's geometry on worker threads)."""
+def _write(w: Writer, sc: Scenario, stages: Stages, truth: Iterator, progress: bool, ahead: bool = False) -> None:
+    """Every block of the run into ``w``: truth and IMU rows per ``truth`` block, then the GNSS epochs of each block
+    (``ahead``: the next GNSS slice's geometry on a worker thread)."""
     _write_static(w, sc, stages)
     bar = None
     if progress:
@@ -263,8 +272,7 @@ def _write(w: Writer, sc: Scenario, stages: Stages, block_samples: int, progress
 
         bar = tqdm(total=stages.trajectory.n_samples(), unit="sample", unit_scale=True, desc=sc.name, leave=False)
     try:
-        blocks = _truth_rows(w, stages, _truth_ahead(stages.trajectory.blocks(block_samples=block_samples), ahead),
-                             bar)
+        blocks = _truth_rows(w, stages, truth, bar)
         if stages.gnss is None:
             for _ in blocks:
                 pass

@@ -15,8 +15,8 @@ from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import h5py
 import numpy as np
 
 from ..atomic import remove_stale_temporaries, temporary_name
@@ -25,6 +25,9 @@ from ..version import __version__
 from . import schema
 from .schema import SCHEMA_VERSION
 from .shuffle_deflate import shuffle_deflate
+
+if TYPE_CHECKING:  # h5py is imported when a file opens: a run starts its truth while h5py loads (25 ms)
+    import h5py
 
 CHUNK_ROWS = 1 << 16  # time samples per chunk along the first axis
 # A series whose first chunk deflates to more than this fraction of its bytes is stored raw: its chunks skip the
@@ -109,6 +112,8 @@ class Writer:
 
     def __enter__(self) -> "Writer":
         remove_stale_temporaries(self.path)
+        import h5py
+
         self.file = h5py.File(self.tmp, "w")
         f = self.file
         f.attrs["schema_version"] = SCHEMA_VERSION
@@ -228,6 +233,8 @@ class Writer:
         data = np.asarray(data)
         spec = schema.check(name, data.dtype, data.shape)
         if data.dtype.kind in "UO":
+            import h5py
+
             data = data.astype(h5py.string_dtype())
         self._describe(self.file.create_dataset(name, data=data), spec, attrs)
 
