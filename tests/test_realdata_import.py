@@ -77,6 +77,20 @@ def test_glonass_carriers_take_each_satellites_frequency_number(kms3):
     np.testing.assert_allclose(g.sat_wavelength_m, 299792458.0 / freq)
 
 
+def test_missing_frequency_numbers_are_named_for_glonass_satellites_only(tmp_path):
+    """solo0150.16o has no 'GLONASS SLOT / FRQ #' and no navigation file is given: the note names the GLONASS
+    satellites (their G1/G2 frequencies are unknown), not the GPS and BDS ones, which carry no FDMA signal."""
+    with simkit.open(_import(tmp_path, OBS / "solo0150.16o")) as ds:
+        report = json.loads(ds.attrs["import_report"])
+        sats = [str(s) for s in ds["gnss/sat_id"][:]]
+        freq = ds["gnss/sat_frequency_hz"][:]
+    note = next(n for n in report["notes"] if "GLONASS frequency number" in n)
+    named = note.split(" for ")[1].split(":")[0].split()
+    assert named and all(s.startswith("R") for s in named)
+    assert sorted(named) == sorted(s for s in sats if s.startswith("R"))
+    assert np.isnan(freq[[sats.index(s) for s in named]]).any(axis=1).all()
+
+
 def test_satellites_sit_where_the_pseudoranges_say(kms3):
     """At each epoch, code + c dT - |r_sat - r_ref| - Sagnac is one receiver clock for all GPS satellites above
     10 deg, up to the atmosphere, group delay and noise (< 25 m spread): orbits and clocks at the emission time

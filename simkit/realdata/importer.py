@@ -273,6 +273,9 @@ def _sat_frequencies(sats, signals, header_channels: dict, nav_channels: dict, r
             if not g.is_fdma:
                 out[i, j] = g.freq_hz
                 continue
+            if sat[0] != g.system:    # another system's satellite does not transmit the FDMA signal
+                out[i, j] = np.nan
+                continue
             k = header_channels.get(sat, nav_channels.get(sat))
             out[i, j] = np.nan if k is None else float(g.frequency_for(k))
             if k is None and sat not in unknown:
