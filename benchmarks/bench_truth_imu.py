@@ -137,6 +137,8 @@ def theirs_in_memory(pathgen, seconds: float, rate: float) -> float:
 BREAKDOWN = r"""
 import json, resource, sys, time
 t_python = time.process_time()                      # the interpreter's own start-up (site, encodings)
+import simkit.cli
+simkit.cli.one_blas_thread()                        # as `simkit run` does, before numpy loads
 from simkit.heap import keep_freed_memory
 from simkit import pipeline
 from simkit.imu import simulator

@@ -44,6 +44,8 @@ def timed(lane, label, fn):
 
 
 import simkit.cli
+if hasattr(simkit.cli, "one_blas_thread"):   # as `simkit run` does, before numpy loads (absent in older trees)
+    simkit.cli.one_blas_thread()
 from simkit import pipeline
 from simkit.imu import simulator
 from simkit.io import writer

@@ -207,10 +207,11 @@ def test_the_fitted_fragment_is_a_valid_gnss_section(tmp_path):
     assert loaded.gnss.multipath.carrier_sigma_m == pytest.approx(0.01)
 
 
-def test_the_fragment_with_truth_errors_and_acquisition_loads():
+def test_the_fragment_with_truth_errors_acquisition_and_cn0_step_loads():
     from simkit.scenario import load
 
     p = dict(twin.DEFAULTS, iono_residual_fraction=0.2, acquisition={"delay_s": 30.0},
+             cn0_report={"resolution_dbhz": 0.25},
              truth_errors={"tropo_mapping": "niell", "gps_orbit_sigma_rac_m": [0.2, 0.8, 0.5],
                            "gps_clock_sigma_m": 0.7, "bds_geo_igso_sigma_scale": 4.0})
     fragment = tomllib.loads(twin.toml_fragment(p))
@@ -218,13 +219,16 @@ def test_the_fragment_with_truth_errors_and_acquisition_loads():
     sc = twin.scenario(real, np.array([3516213.438, 781859.8595, 5246037.966]), [str(KMS3_NAV)], 5.0, {}, 1)
     sc["gnss"]["truth_errors"] = fragment["gnss"]["truth_errors"]
     sc["gnss"]["acquisition"] = fragment["gnss"]["acquisition"]
+    sc["gnss"]["cn0_report"] = fragment["gnss"]["cn0_report"]
     g = load(sc).gnss
     assert g.acquisition.delay_s == 30.0 and g.truth_errors.iono_residual_fraction == pytest.approx(0.2)
+    assert g.cn0_report.resolution_dbhz == 0.25 and g.cn0_report.sigma_db == 0.0
     assert g.truth_errors.ephemeris["G"].clock_sigma_m == pytest.approx(0.7)
     assert g.truth_errors.ephemeris["C"].geosync_scale == pytest.approx(4.0)
     # the twin's own scenario carries the same keys
     sc2 = twin.scenario(real, np.array([3516213.438, 781859.8595, 5246037.966]), [str(KMS3_NAV)], 5.0, p, 1)
     assert sc2["gnss"]["acquisition"] == {"delay_s": 30.0}
+    assert sc2["gnss"]["cn0_report"] == {"resolution_dbhz": 0.25}
     assert sc2["gnss"]["truth_errors"]["gps_clock_sigma_m"] == 0.7
 
 
@@ -278,8 +282,12 @@ def test_twin_of_a_moving_receiver_along_its_own_spp(tmp_path, capsys):
     sh = fragment["gnss"]["shadowing"]
     assert len(sh["shadowed_probability"]) == len(sh["elevation_deg"]) and len(sh["dwell_s"]) == 3
     with open_dataset(out / "twin_fit.h5") as ds:
-        state = read_gnss(ds, antennas=0, truth=("shadow_state",)).truth["shadow_state"]
-    assert {0, 1} <= set(np.unique(state))
+        g = read_gnss(ds, antennas=0, obs=("cn0",), truth=("shadow_state",))
+    assert {0, 1} <= set(np.unique(g.truth["shadow_state"]))
+    # the u-blox writes whole dB-Hz: so does the calibrated twin ([gnss.cn0_report])
+    assert fragment["gnss"]["cn0_report"] == {"resolution_dbhz": 1.0}
+    for c in g.obs["cn0"].values():
+        assert np.isfinite(c).any() and np.array_equal(c[np.isfinite(c)], np.round(c[np.isfinite(c)]))
     for key in ("holdout", "holdout_interleaved"):
         for c in fid[key]["noise"]["cn0"].values():
             assert "real_against_itself" in c and c["spread_rms_db"] is not None

@@ -13,6 +13,7 @@ from ..errors import ScenarioError
 from ..section import Section, in_range, non_negative, positive
 from . import clock, signals
 from .acquisition import AcquisitionConfig, parse_acquisition
+from .cn0_report import Cn0ReportConfig, parse_cn0_report
 from .shadowing import ShadowingConfig, parse_shadowing
 from .truth_config import TruthErrorsConfig, parse_truth_errors
 
@@ -92,6 +93,7 @@ class GnssConfig:
     truth_errors: TruthErrorsConfig | None = None  # departures of the truth from the receiver's models; None: off
     acquisition: AcquisitionConfig = field(default_factory=AcquisitionConfig)  # rising satellites' first track
     shadowing: ShadowingConfig | None = None  # stochastic street shadowing / blockage of C/N0; None: off
+    cn0_report: Cn0ReportConfig | None = None  # the receiver's C/N0 estimate noise and resolution; None: exact
 
     @property
     def nav_systems(self) -> str:
@@ -140,7 +142,8 @@ def parse_config(sec: Section) -> GnssConfig:
         cn0_offset_db=_cn0_offset(sec.section("cn0_offset_db"), sigs),
         truth_errors=parse_truth_errors(sec.section("truth_errors")),
         acquisition=parse_acquisition(sec.section("acquisition")),
-        shadowing=parse_shadowing(sec.section("shadowing")))
+        shadowing=parse_shadowing(sec.section("shadowing")),
+        cn0_report=parse_cn0_report(sec.section("cn0_report")))
     sec.done()
     return cfg
 

@@ -83,23 +83,27 @@ def normal_quantiles(u) -> np.ndarray:
 
 
 class KeyedNormals:
-    """Draws (M, A, C, G, 5) for the epochs ``k0 .. k0 + M - 1`` of chosen satellite columns."""
+    """Draws (M, A, C, G, P) for the epochs ``k0 .. k0 + M - 1`` of chosen satellite columns: P = ``per_signal``
+    (default :data:`DRAWS_PER_SIGNAL`, the observables' noise) from the streams ``<stream>/ant<a>/<sat id>``
+    (default ``gnss``; another error term names its own, so it leaves these untouched)."""
 
-    def __init__(self, seed: int, n_antennas: int, sat_ids, signals_of_sat: list[np.ndarray], n_signals: int):
-        self.streams = [[rng.generator(seed, "gnss", f"ant{a}", sid) for sid in sat_ids] for a in range(n_antennas)]
+    def __init__(self, seed: int, n_antennas: int, sat_ids, signals_of_sat: list[np.ndarray], n_signals: int,
+                 per_signal: int = DRAWS_PER_SIGNAL, stream: tuple[str, ...] = ("gnss",)):
+        self.streams = [[rng.generator(seed, *stream, f"ant{a}", sid) for sid in sat_ids] for a in range(n_antennas)]
         self.position = np.zeros((n_antennas, len(sat_ids)), dtype=np.int64)
         self.signals_of_sat = signals_of_sat
         self.n_signals = n_signals
+        self.per_signal = per_signal
 
     def draw(self, k0: int, m: int, cols: np.ndarray) -> np.ndarray:
-        """Normals for epochs k0..k0+m-1, satellite columns ``cols`` (C,): (m, A, C, G, 5), zero for signals a
+        """Normals for epochs k0..k0+m-1, satellite columns ``cols`` (C,): (m, A, C, G, P), zero for signals a
         satellite does not transmit."""
-        n_ant = len(self.streams)
-        out = np.zeros((m, n_ant, cols.size, self.n_signals, DRAWS_PER_SIGNAL))
-        buf = np.empty(m * self.n_signals * DRAWS_PER_SIGNAL)
+        n_ant, per = len(self.streams), self.per_signal
+        out = np.zeros((m, n_ant, cols.size, self.n_signals, per))
+        buf = np.empty(m * self.n_signals * per)
         for c, s in enumerate(cols):
             sigs = self.signals_of_sat[s]
-            per_epoch = sigs.size * DRAWS_PER_SIGNAL
+            per_epoch = sigs.size * per
             view = consecutive(sigs)   # consecutive signals: written through a view
             for a in range(n_ant):
                 gen = self.streams[a][s]
@@ -111,6 +115,6 @@ class KeyedNormals:
                 if isinstance(view, slice):
                     _quantiles(u, _HALF_ULP, out[:, a, c, view])
                 else:
-                    out[:, a, c, sigs] = normal_quantiles(u + _HALF_ULP).reshape(m, sigs.size, DRAWS_PER_SIGNAL)
+                    out[:, a, c, sigs] = normal_quantiles(u + _HALF_ULP).reshape(m, sigs.size, per)
                 self.position[a, s] = (k0 + m) * per_epoch
         return out

@@ -60,6 +60,7 @@ class SignalTruth:
     sigma_carrier: np.ndarray
     sigma_doppler: np.ndarray
     multipath_rate: np.ndarray | None = None   # with an [environment]: rate of multipath_carrier in the Doppler
+    cn0: np.ndarray | None = None   # with [gnss.cn0_report]: the true C/N0 (dB-Hz) behind the reported estimate
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,7 @@ from ..constellation.geometry import RECEPTION_GRID_S
 from ..earth import C_LIGHT, EARTH_RATE_ECEF
 from ..environment import DIRECT_REFLECTED, NLOS, Environment, LineOfSight
 from ..errors import DataFileError, ScenarioError
-from . import atmosphere, noise, signals as sigmod, tworay
+from . import atmosphere, cn0_report, noise, signals as sigmod, tworay
 from .acquisition import Acquisition
 from .clock import ClockProcess
 from .config import GnssConfig, check_sats, code_scale_at
@@ -123,6 +123,8 @@ class GnssSimulator:
                        for a in range(n_clk)]
         sys_signals = [np.flatnonzero([g.system == sys for g in self.signals]) for sys in self.system]
         self.draws = KeyedNormals(seed, self.n_ant, self.sat_ids, sys_signals, len(self.signals))
+        self.cn0_draws = None if cfg.cn0_report is None else KeyedNormals(   # the receiver's C/N0 estimate
+            seed, self.n_ant, self.sat_ids, sys_signals, len(self.signals), per_signal=1, stream=("gnss", "cn0_report"))
         taus = [cfg.multipath.signal_correlation_time_s.get(g.name, cfg.multipath.correlation_time_s)
                 for g in self.signals]
         self.mp = multipath_bank(self.dt, np.array(taus)[:, None],
@@ -288,8 +290,9 @@ class GnssSimulator:
             vis_c = vis_c & (shadow.state != BLOCKED)
         vis_c = self.acquisition.apply(t, vis_c, view.elevation, cand)
         draws = self.draws.draw(k0, t.size, cand) * vis_c[..., None, None]
+        cn0_z = None if self.cn0_draws is None else self.cn0_draws.draw(k0, t.size, cand)[..., 0]   # (M, A, C, G)
         parts = _Parts(self, t, geo.week, geo.sow, cand, view, vis_c, off, draws, geo.ref, geo.ant_vel,
-                       geo.atmosphere, los, shadow)
+                       geo.atmosphere, los, shadow, cn0_z)
         return GnssEpochs(t=t, sat_pos_ecef=geo.ref["sat_pos_emission"], sat_clock=geo.ref["sat_clock"],
                           truth=parts.truth(geo.ant_pos, geo.ant_vel), obs=parts.obs, signal_truth=parts.signal_truth)
 
@@ -416,8 +419,9 @@ class _Parts:
     """The error terms and observables of one block, computed step by step on the candidate columns."""
 
     def __init__(self, sim: GnssSimulator, t, week, sow, cand, view, vis_c, off, draws, ref, ant_vel, atmo, los=None,
-                 shadow=None):
+                 shadow=None, cn0_z=None):
         self.sim, self.cand, self.view, self.m, self.los, self.shadow = sim, cand, view, t.size, los, shadow
+        self.cn0_z = cn0_z
         self.t, self.week, self.sow = t, week, sow
         self.shape = (t.size, sim.n_ant, len(sim.sat_ids))
         err = sim.cfg.errors
@@ -542,17 +546,21 @@ class _Parts:
         def put(x, masked=False):
             return place_columns(x, cols, self.shape[2], keep if masked else None)
 
+        report = cfg.cn0_report
+        cn0_out = cn0 if report is None else cn0_report.reported(cn0, self.cn0_z[..., cj, j], report)
+
         self.obs[g.name] = SignalObs(
             code=put(base + gd + iono + mp_c + n_c, True),
             carrier=put((base - iono + mp_p + n_p) / lam + amb[..., cols, j], True),
             doppler=put(-(rate - iono_rate + (0.0 if mp_rate is None else mp_rate)) / lam + n_d, True),
-            cn0=put(cn0, True),
+            cn0=put(cn0_out, True),
             ambiguity=amb[..., j], lli=lli[..., j])
         self.signal_truth[g.name] = SignalTruth(
             ionosphere=put(iono), ionosphere_rate=put(iono_rate), multipath_code=put(mp_c),
             multipath_carrier=put(mp_p), noise_code=put(n_c), noise_carrier=put(n_p), noise_doppler=put(n_d),
             sigma_code=put(sig_c), sigma_carrier=put(sig_p), sigma_doppler=put(sig_d),
-            multipath_rate=None if mp_rate is None else put(mp_rate))
+            multipath_rate=None if mp_rate is None else put(mp_rate),
+            cn0=None if report is None else put(cn0, True))
 
     def _environment(self, cj, g, cn0, mp_c, mp_p):
         """C/N0 and multipath of signal ``g`` on columns ``cj`` under the environment: a direct signal plus a

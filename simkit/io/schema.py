@@ -168,6 +168,8 @@ _GNSS = [
     _f("gnss/truth/<signal>/sigma_code", "f8", ("M", "A", "S"), "m", "", "gnss", "code noise sigma"),
     _f("gnss/truth/<signal>/sigma_carrier", "f8", ("M", "A", "S"), "m", "", "gnss", "carrier noise sigma"),
     _f("gnss/truth/<signal>/sigma_doppler", "f8", ("M", "A", "S"), "Hz", "", "gnss", "Doppler noise sigma"),
+    _f("gnss/truth/<signal>/cn0", "f8", ("M", "A", "S"), "dB-Hz", "", "gnss",
+       "true C/N0 behind the reported estimate (with [gnss.cn0_report])"),
 ]
 _REFERENCE = [
     _f("reference/pos_ecef", "f8", (3,), "m", "ECEF", "import",

@@ -202,6 +202,25 @@ def satellite_spread(values, el_deg, edges_deg) -> float | None:
     return float(np.sqrt(num / dof)) if dof else None
 
 
+# Output steps of receivers' reported C/N0 (dB-Hz), coarsest first: whole dB-Hz (many mass-market receivers),
+# halves, quarters (RINEX 3 files of geodetic receivers), fifths, eighths, tenths
+CN0_STEPS_DBHZ = (1.0, 0.5, 0.25, 0.2, 0.125, 0.1)
+
+
+def cn0_resolution(series) -> float:
+    """The step of a receiver's reported C/N0 (dB-Hz): the coarsest of :data:`CN0_STEPS_DBHZ` of which every
+    value in ``series`` (arrays, NaN where absent) is a multiple, to the 0.001 dB-Hz that RINEX writes; 0 when
+    there is none (a continuous estimate) or fewer than 10 values or 3 distinct ones (nothing to tell)."""
+    values = np.concatenate([np.ravel(np.asarray(x, float)) for x in series] or [np.empty(0)])
+    values = values[np.isfinite(values)]
+    if values.size < 10 or np.unique(values).size < 3:
+        return 0.0
+    for step in CN0_STEPS_DBHZ:
+        if np.all(np.abs(values - step * np.round(values / step)) < 5e-4):
+            return step
+    return 0.0
+
+
 def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
     """Per signal: mean C/N0 (dB-Hz) of real and twin (pooled over realisations) per elevation bin over the
     satellite-epochs both track, with standard errors (:func:`bin_mean`; the real side's at least the

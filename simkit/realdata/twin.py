@@ -116,7 +116,8 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                                       **p.get("truth_errors", {})}}
                     if p.get("iono_residual_fraction") is not None or p.get("truth_errors") else {}),
                  **({"acquisition": dict(p["acquisition"])} if p.get("acquisition") else {}),
-                 **({"shadowing": dict(p["shadowing"])} if p.get("shadowing") else {})},
+                 **({"shadowing": dict(p["shadowing"])} if p.get("shadowing") else {}),
+                 **({"cn0_report": dict(p["cn0_report"])} if p.get("cn0_report") else {})},
         **({"environment": {"reflections": False, "body_mask": [dict(p["horizon_mask"])]}}
            if p.get("horizon_mask") else {}),
     }
@@ -280,7 +281,11 @@ def fit_parameters(real: dict, reference) -> dict:
 def _fit_cn0(real, sigs, el, p) -> bool:
     """Set ``p``'s zenith C/N0, rolloff, per-signal C/N0 offsets and gain pattern from the real C/N0 (least
     squares of the quadratic model with one offset per signal beyond the first, relative to the signal table's,
-    then :func:`_gain_pattern`); False when the file has no signal strength."""
+    then :func:`_gain_pattern`), and the step of its reported values ([gnss.cn0_report]); False when the file
+    has no signal strength."""
+    step = noise_fit.cn0_resolution(real["obs"]["cn0"].values())
+    if step > 0:   # the receiver writes its C/N0 in steps: the twin's is rounded the same way
+        p["cn0_report"] = {"resolution_dbhz": step}
     rows_x, rows_y, names = [], [], []
     for g in sigs:
         c = real["obs"]["cn0"][g.name]
@@ -442,6 +447,9 @@ def toml_fragment(p: dict) -> str:
         lines += [f"{k} = {_toml_list(v)}" for k, v in sh.items() if k != "systems"]
         for letter, table in sh.get("systems", {}).items():
             lines += [f"[gnss.shadowing.systems.{letter}]", *(f"{k} = {_toml_list(v)}" for k, v in table.items())]
+    if p.get("cn0_report"):
+        lines += ["", "# the receiver's C/N0 output step (the real file's values are multiples of it)",
+                  "[gnss.cn0_report]", *(f"{k} = {v:g}" for k, v in p["cn0_report"].items())]
     if p.get("acquisition"):
         lines += ["", "# rising satellites: first tracked this long after they cross the mask (acquisition.py)",
                   "[gnss.acquisition]", f"delay_s = {p['acquisition']['delay_s']:.1f}"]
