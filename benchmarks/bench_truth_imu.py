@@ -88,7 +88,7 @@ def scenario(seconds: float, rate: float) -> str:
     return tomli_w.dumps(data)
 
 
-OUR_RUNS = 3  # simkit's figure is the median of this many fresh runs (a run is under a second: one is noisy)
+OUR_RUNS = 5  # simkit's figure is the median of this many fresh runs (a run is under a second: one is noisy)
 
 
 def ours(tmp: Path, seconds: float, rate: float, runs: int = OUR_RUNS) -> tuple[float, float, int]:
