@@ -193,6 +193,11 @@ print(f"{time.perf_counter() - t0:.2f} {r.ru_utime + r.ru_stime:.2f}")
 
 STAGES = r"""
 import sys, time
+import simkit.cli
+if hasattr(simkit.cli, "one_blas_thread"):    # as `simkit run` does (absent in older trees)
+    simkit.cli.one_blas_thread()
+from simkit.heap import keep_freed_memory
+keep_freed_memory()                            # as simkit.pipeline.run does: without it every block faults its pages
 from simkit import pipeline
 from simkit.scenario import load
 sc = load(sys.argv[1], [])
