@@ -5,6 +5,7 @@ station's own header position.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 
 import numpy as np
@@ -178,3 +179,30 @@ def test_plot_runs_on_a_real_file(kms3, tmp_path):
     _solve(kms3, "broadcast")
     assert main(["plot", str(kms3), "--out", str(tmp_path / "plots")]) == 0
     assert list((tmp_path / "plots").rglob("*.png"))
+
+
+def test_the_glonass_frequency_note_names_glonass_satellites_only(tmp_path, kms3):
+    """A satellite of another system has no GLONASS frequency number to miss: the import note lists only the
+    GLONASS satellites without one (solo0150 without navigation: its header gives none), and none for KMS3, whose
+    header gives every observed GLONASS satellite's number."""
+    def note(path):
+        with simkit.open(path) as ds:
+            notes = json.loads(ds.attrs["import_report"])["notes"]
+        return [n for n in notes if "GLONASS frequency number" in n]
+
+    assert note(kms3) == []
+    solo = _import(tmp_path, OBS / "solo0150.16o")
+    [line] = note(solo)
+    listed = line.split(" for ", 1)[1].split(":")[0].split()
+    glonass = [s for s in rinex_obs.read(OBS / "solo0150.16o").systems["R"].sats]
+    assert listed and sorted(listed) == sorted(glonass)
+
+
+def test_nav_takes_a_bundled_file_name_from_any_folder(tmp_path, kms3):
+    """`--nav NAME` of a navigation file shipped in simkit/data works from any folder, as `simkit sky NAME` does
+    (the commands of docs/real_data.md), and gives the file the explicit path gives."""
+    out = tmp_path / "named.h5"
+    with contextlib.chdir(tmp_path):
+        assert main(["import", str(KMS3_OBS), "--nav", KMS3_NAV.name, "-o", str(out), "-q"]) == 0
+    with simkit.open(out) as a, simkit.open(kms3) as b:
+        np.testing.assert_array_equal(a["gnss/sat_pos_ecef"][:], b["gnss/sat_pos_ecef"][:])
