@@ -67,6 +67,11 @@ RUN_CASES = [
      "scenario.duration_s: missing required key (expected a number; found 'duraton_s'"),
     (GOOD.replace('name = "tiny"', 'name = "a b"'), [], "scenario.name: must be letters"),
     ("[scenario\nname = 1\n", [], "not valid TOML"),
+    # a typo'd table is named itself, before the required keys it leaves missing (was "trajectory.rate_hz:
+    # missing required key", or "known keys: gnss, scenario, trajectory" without imu and environment)
+    (GOOD.replace("[trajectory]", "[trajectroy]"), [], "trajectroy: unknown key (did you mean 'trajectory'?)"),
+    (GOOD + "\n[imus]\npreset = 'ideal'\n", [], "imus: unknown key (did you mean 'imu'?)"),
+    (GOOD + "\n[enviroment]\n", [], "enviroment: unknown key (did you mean 'environment'?)"),
     (GOOD + GNSS.format(mask=10.0, source="nominal:gps") + GNSS.format(mask=10.0, source="nominal:gps")
      .replace("[gnss]\nrate_hz = 1.0\nelevation_mask_deg = 10.0\nsignals = [\"L1C\"]\n", ""), [],
      "satellites loaded twice"),
@@ -82,6 +87,14 @@ def test_run_bad_scenarios(tmp_path, text, extra, expect):
 def test_run_directory_as_scenario(tmp_path):
     (tmp_path / "folder").mkdir()
     assert_clean_error(["run", "folder", "-q"], tmp_path, "is a directory, expected a scenario TOML file")
+
+
+def test_run_of_a_simulated_file_names_it(tmp_path):
+    """`simkit run out.h5` (a simulated file given for its scenario): one line saying what the file is, not a
+    UTF-8 decoding error."""
+    (tmp_path / "done.h5").write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(64))
+    assert_clean_error(["run", "done.h5", "-q", "-o", "out.h5"], tmp_path,
+                       "done.h5: is an HDF5 file (a simulated one?), expected a scenario TOML file")
 
 
 def test_run_missing_scenario(tmp_path):

@@ -126,6 +126,8 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
         path = resolve(scenario)
         source, base_dir = str(scenario), path.parent
         try:
+            if path.read_bytes()[:8] == b"\x89HDF\r\n\x1a\n":  # the HDF5 signature: a simulated file, not a scenario
+                raise ScenarioError("", "is an HDF5 file (a simulated one?), expected a scenario TOML file", source)
             text = path.read_text(encoding="utf-8")
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
@@ -146,6 +148,7 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
 
 def _validate(data: dict, base_dir: Path | None = None) -> Scenario:
     root = Section(data, "")
+    root.only("scenario", "trajectory", "imu", "gnss", "environment")
     meta = root.section("scenario", required=True)
     name = meta.get("name", str, check=lambda v: None if re.fullmatch(r"[\w.-]+", v) else
                     "must be letters, digits, '_', '-' or '.'")
