@@ -206,3 +206,19 @@ def test_nav_takes_a_bundled_file_name_from_any_folder(tmp_path, kms3):
         assert main(["import", str(KMS3_OBS), "--nav", KMS3_NAV.name, "-o", str(out), "-q"]) == 0
     with simkit.open(out) as a, simkit.open(kms3) as b:
         np.testing.assert_array_equal(a["gnss/sat_pos_ecef"][:], b["gnss/sat_pos_ecef"][:])
+
+
+def test_plot_of_a_real_file_without_reference_says_why_and_leaves_nothing(tmp_path):
+    """Berlin has no reference position: its SPP cannot be scored, so `simkit plot` names the solutions it skips
+    and why, says no figure was drawn (exit 1), and leaves no empty folder (it was exit 2 on the first solution,
+    or an empty folder and exit 0)."""
+    from cli_errors import run_cli
+
+    out = _import(tmp_path, BERLIN_OBS, [BERLIN_NAV])
+    assert main(["solve", str(out), "--filter", "spp", "-q", "--set", 'estimator.systems="G"']) == 0
+    proc = run_cli(["plot", out.name, "--out", "figs"], tmp_path)
+    lines = [ln for ln in proc.stderr.replace("\r", "\n").splitlines() if ln.startswith(("plot: skipped", "simkit"))]
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert lines[0].startswith("plot: skipped the figures of /solutions/spp: ") and "no /truth" in lines[0]
+    assert lines[1].startswith(f"simkit plot: error: {out.name}: no figure drawn") and len(lines) == 2
+    assert not (tmp_path / "figs").exists() and not list(tmp_path.glob(".figs*"))

@@ -1,9 +1,10 @@
 """``simkit plot FILE.h5 [--out DIR]``: overview figures of a simkit file as PNGs (needs the ``plot`` extra)."""
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
-from ..errors import ScenarioError
+from ..errors import ScenarioError, SimkitError
 
 
 def add_parser(sub):
@@ -32,7 +33,11 @@ def run(args) -> int:
     require_matplotlib("simkit plot")
     open_dataset(args.file).close()
     with staged_directory(out) as tmp, tqdm(total=len(FIGURES), desc="plot", unit="figure", leave=False) as bar:
-        paths = [p.relative_to(tmp) for p in file_figures(args.file, tmp, bar)]
+        paths = [p.relative_to(tmp) for p in file_figures(args.file, tmp, bar,
+                                                            on_skip=lambda line: bar.write(line, file=sys.stderr))]
+        if not paths:  # raised inside the block: no empty folder is left
+            raise SimkitError(f"{args.file}: no figure drawn: the overview figures need /truth (the Allan "
+                              f"figure /imu), a solution's figures /truth or /reference to score it against")
     for p in paths:
         print(out / p)
     return 0

@@ -214,7 +214,11 @@ def _solutions(path, out, on_skip) -> list[Path]:
     names = solution_names(path)
     if not names:
         return paths
-    truth = read_truth(path)
+    try:
+        truth = read_truth(path)
+    except SimkitError as exc:  # a real file without a reference position: nothing to score the solutions against
+        on_skip(f"plot: skipped the figures of {', '.join(f'/solutions/{n}' for n in names)}: {exc}")
+        return paths
     for name in names:
         try:
             sc = score(truth, read_solution(path, name), where=f"/solutions/{name}")
