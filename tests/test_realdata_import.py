@@ -222,3 +222,15 @@ def test_plot_of_a_real_file_without_reference_says_why_and_leaves_nothing(tmp_p
     assert lines[0].startswith("plot: skipped the figures of /solutions/spp: ") and "no /truth" in lines[0]
     assert lines[1].startswith(f"simkit plot: error: {out.name}: no figure drawn") and len(lines) == 2
     assert not (tmp_path / "figs").exists() and not list(tmp_path.glob(".figs*"))
+
+
+@pytest.mark.parametrize("solver", ["attitude", "attitude_c", "tdcp"])
+def test_an_attitude_solver_on_a_real_file_names_its_one_antenna(kms3, solver, capsys):
+    """An imported file has one antenna: the carrier-phase solvers say so (it was "gnss/obs/L1C/ambiguity: no
+    such dataset"), one line, exit 1, nothing stored."""
+    assert main(["solve", str(kms3), "--filter", solver, "-q"]) == 1
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert err == [f"simkit solve: {solver}: failed: gnss/antennas/lever_arm_b: 1 antenna(s); expected at least 2 "
+                   "(one baseline)"]
+    with simkit.open(kms3) as ds:
+        assert f"solutions/{solver}/t" not in ds
