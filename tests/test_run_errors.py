@@ -206,6 +206,20 @@ def test_inspect_and_rinex_bad_files(tmp_path):
     assert_clean_error(["rinex", "text.h5", "-o", "text.h5"], tmp_path, "exists and is not a folder")
 
 
+def test_a_truncated_simkit_file_is_named_as_one(tmp_path):
+    """A simkit file cut short (an interrupted copy) starts with the HDF5 signature: it is named as a damaged
+    HDF5 file, not as "not an HDF5 file", by every reader."""
+    import simkit
+
+    whole = simkit.run(tmp_path / _scenario(tmp_path, GOOD), out=tmp_path / "t.h5")
+    data = whole.read_bytes()
+    (tmp_path / "cut.h5").write_bytes(data[: len(data) // 2])
+    whole.unlink()
+    for verb in (["inspect"], ["solve"], ["allan"], ["plot", "--out", "p"], ["score", "cut.h5"], ["validate"]):
+        assert_clean_error([verb[0], "cut.h5", *verb[1:]], tmp_path,
+                           "cut.h5: a damaged or truncated HDF5 file (an interrupted copy?)")
+
+
 def test_rinex_of_a_file_without_gnss(tmp_path):
     import simkit
 
