@@ -7,7 +7,7 @@ from pathlib import Path
 import h5py
 import pytest
 
-from cli_errors import assert_clean_error, digest, run_cli
+from cli_errors import ROOT, assert_clean_error, digest, run_cli
 
 GOOD = """[scenario]
 name = "tiny"
@@ -139,6 +139,25 @@ def test_run_never_replaces_a_file_it_did_not_write(tmp_path, name, make, expect
     before = digest(tmp_path / name)
     assert_clean_error(["run", "quickstart", "-q", "-o", name, "--set", "scenario.duration_s=2"], tmp_path, expect)
     assert digest(tmp_path / name) == before
+
+
+@pytest.mark.parametrize("what", ["log", "navigation"])
+def test_run_force_never_replaces_a_file_the_scenario_reads(tmp_path, what):
+    """`--force` replaces a file a run did not write, but never one the run reads: its trajectory log or a
+    constellation source (before, `run replay_drive.toml -o drive_1hz.nmea --force` overwrote the log)."""
+    import shutil
+
+    nav = ROOT / "simkit" / "data" / "BRDM00DLR_S_20261170000_01D_MN.rnx.gz"
+    shutil.copyfile(ROOT / "examples" / "drive_1hz.nmea", tmp_path / "drive.nmea")
+    shutil.copyfile(nav, tmp_path / "nav.rnx.gz")
+    text = (ROOT / "examples" / "replay_drive.toml").read_text().replace('"drive_1hz.nmea"', '"drive.nmea"')
+    text = text.replace(f'"{nav.name}"', '"nav.rnx.gz"').replace("duration_s = 280.0", "duration_s = 5.0")
+    name = _scenario(tmp_path, text)
+    target = {"log": "drive.nmea", "navigation": "nav.rnx.gz"}[what]
+    before = digest(tmp_path / target)
+    assert_clean_error(["run", name, "-q", "-o", target, "--force"], tmp_path,
+                       f"{target}: is an input of this command; choose another output name")
+    assert digest(tmp_path / target) == before
 
 
 def test_run_replaces_its_own_output_and_anything_with_force(tmp_path):
