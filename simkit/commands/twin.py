@@ -44,7 +44,7 @@ def run(args) -> int:
 
         require_matplotlib("twin (or --no-plots)")
     reference, source = importer.parse_reference(args.reference, None)
-    fid = twin.run_twin(obs, navs, out, fit=args.fit, seed=args.seed, reference=reference,
+    fid = twin.run_twin(obs, navs, out, fit=args.fit, seed=args.seed, reference=reference, progress=True,
                         reference_source=source, trajectory=args.trajectory,
                         trajectory_solution=args.trajectory_solution, code_model=args.code_model,
                         realisations=args.realisations, shadowing=not args.no_shadowing)
