@@ -110,6 +110,9 @@ class PyinsLooselyCoupled:
         fixes = pd.DataFrame([f[1:] for f in self.fixes], index=[f[0] for f in self.fixes],
                              columns=["lat", "lon", "alt"])
         lever_frd = frames.enu_to_ned(self.init.lever_arm_b[0])
+        # pyins' batch filter shows no progress: say what the next minute or two is (660-960 samples/s here)
+        print(f"pyins: run_feedback_filter over {len(data)} IMU samples and {len(fixes)} fixes ...", file=sys.stderr,
+              flush=True)
         result = filters.run_feedback_filter(
             self.initial_pva(data[0, 0]), position_sd=1.0, velocity_sd=0.1, level_sd=0.05, azimuth_sd=0.2,
             increments=increments, gyro_model=inertial_sensor.EstimationModel(**self.gyro),

@@ -110,7 +110,8 @@ def kernels_cold(filters=None) -> bool:
 
 
 # What `simkit compile` runs: the bundled quickstart (one antenna) and a 60 s Xi'an file (three antennas), each
-# simulated and solved by every filter, so that the kernels of a first `simkit run` / `simkit solve` are compiled
+# simulated and solved by every filter, so that the kernels of a first `simkit run` / `simkit solve` are compiled;
+# the Xi'an file validated (`simkit validate`), and 5 s of urban_canyon (the ray tracer of an [environment])
 _PREPARE = r"""
 import tempfile, tomllib
 from pathlib import Path
@@ -124,6 +125,8 @@ with tempfile.TemporaryDirectory() as tmp:
     for name, scenario in (("quickstart", "quickstart"), ("xian", xian)):
         path = simkit.run(scenario, out=f"{tmp}/{name}.h5")
         simkit.solve(path, list(registry()), on_each=lambda *a: None)
+    simkit.validate(path)
+    simkit.run("urban_canyon", out=f"{tmp}/urban.h5", overrides=["scenario.duration_s=5"])
 # the parallel broadcast-orbit kernel of large calls (a day of `simkit sky` or `simkit validate`)
 import numpy as np
 from simkit.constellation import kepler

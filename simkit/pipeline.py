@@ -68,7 +68,7 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
         raise OutputError(out, f"the run would write about {size / 2**30:.0f} GiB (limit {MAX_OUTPUT_BYTES / 2**30:.0f}"
                           f" GiB; scenario.duration_s = {sc.duration_s:g}); --force to run it anyway")
     source = None if isinstance(scenario, dict) else _scenario_file(scenario)
-    check_output(out, inputs=[source], estimated_bytes=size, force=force, simkit_only=True)
+    check_output(out, inputs=[source, *sc.inputs], estimated_bytes=size, force=force, simkit_only=True)
     threads = compression_threads() if threads is None else threads
     traj = Trajectory(sc.trajectory, sc.duration_s)
     # the truth starts now, on its worker, while the IMU and GNSS stages are built and h5py loads

@@ -111,6 +111,12 @@ class Section:
             raise self.error(name, "expected an array of tables ([[...]])")
         return [Section(item, f"{self.key(name)}[{i}]") for i, item in enumerate(items)]
 
+    def only(self, *names: str) -> None:
+        """Reject, before anything is read, a key that is none of ``names``: a typo'd table is then named itself
+        (with the nearest known name), not through the required keys it leaves missing elsewhere."""
+        self._seen.update(names)
+        self.done()
+
     def done(self) -> None:
         """Reject keys that were never read: a typo must not be silently ignored."""
         unknown = [k for k in self.data if k not in self._seen]

@@ -45,7 +45,22 @@ def test_sky_environment_bad_input(tmp_path):
     (tmp_path / "bad.toml").write_text("[environment]\ncanyon = { width_m = 10.0 }\n")
     assert_clean_error(["sky", *SITE, "--environment", "bad.toml"], tmp_path,
                        expect="bad.toml: environment.canyon[0].height_m: missing required key")
-    assert_clean_error(["sky", *SITE, "--environment", "missing.toml"], tmp_path, expect="missing.toml: cannot read")
+    assert_clean_error(["sky", *SITE, "--environment", "missing.toml"], tmp_path,
+                       expect="--environment: missing.toml: no such scenario file (bundled scenarios: ")
+    (tmp_path / "folder").mkdir()
+    assert_clean_error(["sky", *SITE, "--environment", "folder"], tmp_path,
+                       expect="--environment: folder: is a directory, expected a scenario TOML file")
+
+
+def test_sky_environment_takes_a_bundled_scenario_name(tmp_path):
+    """`--environment urban_canyon` from any folder, as `simkit run urban_canyon` (docs/urban.md): the same
+    table as the bundled file's path gives (the name was read as a path: "cannot read")."""
+    args = ["sky", *SITE, "--hours", "0.5", "--step", "900", "--environment"]
+    by_name = run_cli(args + ["urban_canyon"], tmp_path)
+    by_path = run_cli(args + [str(resolve("urban_canyon"))], tmp_path)
+    assert by_name.returncode == 0, by_name.stderr
+    rows = lambda out: [ln for ln in out.stdout.splitlines() if ln.startswith("2026-04-27")]  # noqa: E731
+    assert rows(by_name) and rows(by_name) == rows(by_path)
 
 
 @pytest.fixture(scope="module")

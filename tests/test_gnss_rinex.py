@@ -94,3 +94,15 @@ def test_marker_type_and_name_follow_the_vehicle(tmp_path):
         head = (out / f"{name}_ant0.rnx").read_text().split("END OF HEADER")[0]
         assert f"{kind:<60}MARKER TYPE" in head, name
         assert f"{name.upper()}_ANT0" in head
+
+
+def test_rinex_export_of_an_imported_file_is_one_line(tmp_path):
+    """An imported real file has no simulated receiver clock (its time tags already are receiver time): the
+    export says so in one line, exit 2, and creates no output folder (it was a KeyError traceback)."""
+    from cli_errors import assert_clean_error
+    from realdata_helpers import KMS3_NAV, KMS3_OBS
+    from simkit.cli import main
+
+    assert main(["import", str(KMS3_OBS), "--nav", str(KMS3_NAV), "-o", str(tmp_path / "real.h5"), "-q"]) == 0
+    assert_clean_error(["rinex", "real.h5", "-o", "out"], tmp_path,
+                       expect="real.h5: no /gnss/truth/receiver_clock: the RINEX export needs a simulated file")

@@ -47,6 +47,9 @@ def test_simkit_plot_writes_every_figure_as_png(h5):
     written = {str(p.relative_to(figs)) for p in figs.rglob("*.png")}
     assert written == expected
     assert all(_is_png(figs / name) for name in written)
+    # the bar counts the solutions too (their scoring and figures sat at "6/6": 4-8 s on a 24 h file)
+    total = len(FIGURES) + 1
+    assert f"{total}/{total}" in out.stderr
 
 
 def test_plot_bad_input_is_one_clean_line(h5):

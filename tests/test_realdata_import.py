@@ -5,6 +5,7 @@ station's own header position.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 
 import numpy as np
@@ -75,20 +76,6 @@ def test_glonass_carriers_take_each_satellites_frequency_number(kms3):
     cdma = [j for j, n in enumerate(sigs) if n not in ("G1C", "G2C")]
     np.testing.assert_array_equal(freq[:, cdma], np.broadcast_to(nominal[cdma], (len(sats), len(cdma))))
     np.testing.assert_allclose(g.sat_wavelength_m, 299792458.0 / freq)
-
-
-def test_missing_frequency_numbers_are_named_for_glonass_satellites_only(tmp_path):
-    """solo0150.16o has no 'GLONASS SLOT / FRQ #' and no navigation file is given: the note names the GLONASS
-    satellites (their G1/G2 frequencies are unknown), not the GPS and BDS ones, which carry no FDMA signal."""
-    with simkit.open(_import(tmp_path, OBS / "solo0150.16o")) as ds:
-        report = json.loads(ds.attrs["import_report"])
-        sats = [str(s) for s in ds["gnss/sat_id"][:]]
-        freq = ds["gnss/sat_frequency_hz"][:]
-    note = next(n for n in report["notes"] if "GLONASS frequency number" in n)
-    named = note.split(" for ")[1].split(":")[0].split()
-    assert named and all(s.startswith("R") for s in named)
-    assert sorted(named) == sorted(s for s in sats if s.startswith("R"))
-    assert np.isnan(freq[[sats.index(s) for s in named]]).any(axis=1).all()
 
 
 def test_satellites_sit_where_the_pseudoranges_say(kms3):
@@ -192,3 +179,61 @@ def test_plot_runs_on_a_real_file(kms3, tmp_path):
     _solve(kms3, "broadcast")
     assert main(["plot", str(kms3), "--out", str(tmp_path / "plots")]) == 0
     assert list((tmp_path / "plots").rglob("*.png"))
+
+
+def test_the_glonass_frequency_note_names_glonass_satellites_only(tmp_path, kms3):
+    """A satellite of another system has no GLONASS frequency number to miss: the import note lists only the
+    GLONASS satellites without one (solo0150 without navigation: its header gives none), and none for KMS3, whose
+    header gives every observed GLONASS satellite's number."""
+    def note(path):
+        with simkit.open(path) as ds:
+            notes = json.loads(ds.attrs["import_report"])["notes"]
+        return [n for n in notes if "GLONASS frequency number" in n]
+
+    assert note(kms3) == []
+    solo = _import(tmp_path, OBS / "solo0150.16o")
+    [line] = note(solo)
+    listed = line.split(" for ", 1)[1].split(":")[0].split()
+    glonass = [s for s in rinex_obs.read(OBS / "solo0150.16o").systems["R"].sats]
+    assert listed and sorted(listed) == sorted(glonass)
+    with simkit.open(solo) as ds:                       # and those satellites' FDMA frequencies are unknown
+        sats = [str(x) for x in ds["gnss/sat_id"][:]]
+        assert np.isnan(ds["gnss/sat_frequency_hz"][:][[sats.index(x) for x in listed]]).any(axis=1).all()
+
+
+def test_nav_takes_a_bundled_file_name_from_any_folder(tmp_path, kms3):
+    """`--nav NAME` of a navigation file shipped in simkit/data works from any folder, as `simkit sky NAME` does
+    (the commands of docs/real_data.md), and gives the file the explicit path gives."""
+    out = tmp_path / "named.h5"
+    with contextlib.chdir(tmp_path):
+        assert main(["import", str(KMS3_OBS), "--nav", KMS3_NAV.name, "-o", str(out), "-q"]) == 0
+    with simkit.open(out) as a, simkit.open(kms3) as b:
+        np.testing.assert_array_equal(a["gnss/sat_pos_ecef"][:], b["gnss/sat_pos_ecef"][:])
+
+
+def test_plot_of_a_real_file_without_reference_says_why_and_leaves_nothing(tmp_path):
+    """Berlin has no reference position: its SPP cannot be scored, so `simkit plot` names the solutions it skips
+    and why, says no figure was drawn (exit 1), and leaves no empty folder (it was exit 2 on the first solution,
+    or an empty folder and exit 0)."""
+    from cli_errors import run_cli
+
+    out = _import(tmp_path, BERLIN_OBS, [BERLIN_NAV])
+    assert main(["solve", str(out), "--filter", "spp", "-q", "--set", 'estimator.systems="G"']) == 0
+    proc = run_cli(["plot", out.name, "--out", "figs"], tmp_path)
+    lines = [ln for ln in proc.stderr.replace("\r", "\n").splitlines() if ln.startswith(("plot: skipped", "simkit"))]
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert lines[0].startswith("plot: skipped the figures of /solutions/spp: ") and "no /truth" in lines[0]
+    assert lines[1].startswith(f"simkit plot: error: {out.name}: no figure drawn") and len(lines) == 2
+    assert not (tmp_path / "figs").exists() and not list(tmp_path.glob(".figs*"))
+
+
+@pytest.mark.parametrize("solver", ["attitude", "attitude_c", "tdcp"])
+def test_an_attitude_solver_on_a_real_file_names_its_one_antenna(kms3, solver, capsys):
+    """An imported file has one antenna: the carrier-phase solvers say so (it was "gnss/obs/L1C/ambiguity: no
+    such dataset"), one line, exit 1, nothing stored."""
+    assert main(["solve", str(kms3), "--filter", solver, "-q"]) == 1
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert err == [f"simkit solve: {solver}: failed: gnss/antennas/lever_arm_b: 1 antenna(s); expected at least 2 "
+                   "(one baseline)"]
+    with simkit.open(kms3) as ds:
+        assert f"solutions/{solver}/t" not in ds

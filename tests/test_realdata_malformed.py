@@ -193,6 +193,26 @@ def test_cli_refuses_to_replace_an_input(tmp_path, capsys):
     assert rinex_obs.read(good).t.size == 2
 
 
+@pytest.mark.parametrize("verb", ["import", "twin"])
+@pytest.mark.parametrize("what, expected", [
+    ("obs_dir", "folder: is a directory, expected a RINEX observation file"),
+    ("obs_missing", "none.obs: no such RINEX observation file"),
+    ("nav_dir", "--nav folder: is a directory, expected a RINEX navigation file"),
+    ("nav_missing", "--nav none.rnx: no such file, and not a bundled navigation file (bundled: "
+                    "BRDC00WRD_U_20161580000_01D_MN.rnx.gz"),
+])
+def test_missing_or_folder_inputs_are_one_line(tmp_path, verb, what, expected):
+    """A folder given as the observation or navigation file is named as one, not as a missing file, and a
+    missing navigation file lists the bundled ones `--nav` also takes by name."""
+    from cli_errors import assert_clean_error
+
+    good = _write(tmp_path)
+    (tmp_path / "folder").mkdir()
+    obs = {"obs_dir": "folder", "obs_missing": "none.obs"}.get(what, good.name)
+    nav = {"nav_dir": "folder", "nav_missing": "none.rnx"}.get(what, str(NAV_2016))
+    assert_clean_error([verb, obs, "--nav", nav, "-o", "out"], tmp_path, expect=expected)
+
+
 @pytest.mark.parametrize("args, expected", [
     (["--reference", "1,2"], "expected X,Y,Z in metres"),
     (["--reference", "1,2,3"], "is not a position near the Earth"),

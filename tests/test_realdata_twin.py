@@ -176,6 +176,15 @@ def test_twin_of_kms3_with_fit(tmp_path, capsys):
         assert (out / name).is_file()
 
 
+def test_the_twin_shows_its_progress(tmp_path, capsys):
+    """Each simulated twin shows its progress bar on stderr (`twin --fit` of KMS3 was 27 s of silence, then the
+    report)."""
+    out = tmp_path / "twin"
+    assert main(["twin", str(KMS3_OBS), "--nav", str(KMS3_NAV), "-o", str(out), "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    assert "twin: " in err and "sample/s" in err
+
+
 def test_twin_needs_a_reference_and_navigation(tmp_path, capsys):
     from realdata_helpers import BERLIN_NAV, BERLIN_OBS
 

@@ -75,12 +75,14 @@ def test_a_filter_without_the_interface_is_named(air):
 
 
 @pytest.mark.slow   # pyins' batch filter runs in pandas: about 10 s for 40 s of data
-def test_pyins_loosely_coupled_end_to_end(air, tmp_path):
+def test_pyins_loosely_coupled_end_to_end(air, tmp_path, capfd):
     sys.path.insert(0, str(ROOT / "examples"))
     from pyins_loosely_coupled import PyinsLooselyCoupled, write_native_csv
 
     flt = PyinsLooselyCoupled()
     res = referee.run_filter(flt, air)
+    # the batch filter (a minute on the whole file) is announced, not a silent wait
+    assert "pyins: run_feedback_filter over 4001 IMU samples and 41 fixes ..." in capfd.readouterr().err
     sc = res.score
     assert sc.meta["epochs_scored"] == 40
     # metre-level code fixes with their ionospheric delay: metres horizontally, a few tenths of a degree

@@ -7,7 +7,7 @@ from pathlib import Path
 import h5py
 import pytest
 
-from cli_errors import assert_clean_error, digest, run_cli
+from cli_errors import ROOT, assert_clean_error, digest, run_cli
 
 GOOD = """[scenario]
 name = "tiny"
@@ -67,6 +67,11 @@ RUN_CASES = [
      "scenario.duration_s: missing required key (expected a number; found 'duraton_s'"),
     (GOOD.replace('name = "tiny"', 'name = "a b"'), [], "scenario.name: must be letters"),
     ("[scenario\nname = 1\n", [], "not valid TOML"),
+    # a typo'd table is named itself, before the required keys it leaves missing (was "trajectory.rate_hz:
+    # missing required key", or "known keys: gnss, scenario, trajectory" without imu and environment)
+    (GOOD.replace("[trajectory]", "[trajectroy]"), [], "trajectroy: unknown key (did you mean 'trajectory'?)"),
+    (GOOD + "\n[imus]\npreset = 'ideal'\n", [], "imus: unknown key (did you mean 'imu'?)"),
+    (GOOD + "\n[enviroment]\n", [], "enviroment: unknown key (did you mean 'environment'?)"),
     (GOOD + GNSS.format(mask=10.0, source="nominal:gps") + GNSS.format(mask=10.0, source="nominal:gps")
      .replace("[gnss]\nrate_hz = 1.0\nelevation_mask_deg = 10.0\nsignals = [\"L1C\"]\n", ""), [],
      "satellites loaded twice"),
@@ -82,6 +87,14 @@ def test_run_bad_scenarios(tmp_path, text, extra, expect):
 def test_run_directory_as_scenario(tmp_path):
     (tmp_path / "folder").mkdir()
     assert_clean_error(["run", "folder", "-q"], tmp_path, "is a directory, expected a scenario TOML file")
+
+
+def test_run_of_a_simulated_file_names_it(tmp_path):
+    """`simkit run out.h5` (a simulated file given for its scenario): one line saying what the file is, not a
+    UTF-8 decoding error."""
+    (tmp_path / "done.h5").write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(64))
+    assert_clean_error(["run", "done.h5", "-q", "-o", "out.h5"], tmp_path,
+                       "done.h5: is an HDF5 file (a simulated one?), expected a scenario TOML file")
 
 
 def test_run_missing_scenario(tmp_path):
@@ -126,6 +139,25 @@ def test_run_never_replaces_a_file_it_did_not_write(tmp_path, name, make, expect
     before = digest(tmp_path / name)
     assert_clean_error(["run", "quickstart", "-q", "-o", name, "--set", "scenario.duration_s=2"], tmp_path, expect)
     assert digest(tmp_path / name) == before
+
+
+@pytest.mark.parametrize("what", ["log", "navigation"])
+def test_run_force_never_replaces_a_file_the_scenario_reads(tmp_path, what):
+    """`--force` replaces a file a run did not write, but never one the run reads: its trajectory log or a
+    constellation source (before, `run replay_drive.toml -o drive_1hz.nmea --force` overwrote the log)."""
+    import shutil
+
+    nav = ROOT / "simkit" / "data" / "BRDM00DLR_S_20261170000_01D_MN.rnx.gz"
+    shutil.copyfile(ROOT / "examples" / "drive_1hz.nmea", tmp_path / "drive.nmea")
+    shutil.copyfile(nav, tmp_path / "nav.rnx.gz")
+    text = (ROOT / "examples" / "replay_drive.toml").read_text().replace('"drive_1hz.nmea"', '"drive.nmea"')
+    text = text.replace(f'"{nav.name}"', '"nav.rnx.gz"').replace("duration_s = 280.0", "duration_s = 5.0")
+    name = _scenario(tmp_path, text)
+    target = {"log": "drive.nmea", "navigation": "nav.rnx.gz"}[what]
+    before = digest(tmp_path / target)
+    assert_clean_error(["run", name, "-q", "-o", target, "--force"], tmp_path,
+                       f"{target}: is an input of this command; choose another output name")
+    assert digest(tmp_path / target) == before
 
 
 def test_run_replaces_its_own_output_and_anything_with_force(tmp_path):
@@ -191,6 +223,20 @@ def test_inspect_and_rinex_bad_files(tmp_path):
     assert_clean_error(["inspect", "."], tmp_path, "is a directory")
     assert_clean_error(["rinex", "plain.h5"], tmp_path, "not a simkit file")
     assert_clean_error(["rinex", "text.h5", "-o", "text.h5"], tmp_path, "exists and is not a folder")
+
+
+def test_a_truncated_simkit_file_is_named_as_one(tmp_path):
+    """A simkit file cut short (an interrupted copy) starts with the HDF5 signature: it is named as a damaged
+    HDF5 file, not as "not an HDF5 file", by every reader."""
+    import simkit
+
+    whole = simkit.run(tmp_path / _scenario(tmp_path, GOOD), out=tmp_path / "t.h5")
+    data = whole.read_bytes()
+    (tmp_path / "cut.h5").write_bytes(data[: len(data) // 2])
+    whole.unlink()
+    for verb in (["inspect"], ["solve"], ["allan"], ["plot", "--out", "p"], ["score", "cut.h5"], ["validate"]):
+        assert_clean_error([verb[0], "cut.h5", *verb[1:]], tmp_path,
+                           "cut.h5: a damaged or truncated HDF5 file (an interrupted copy?)")
 
 
 def test_rinex_of_a_file_without_gnss(tmp_path):

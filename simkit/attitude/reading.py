@@ -72,6 +72,10 @@ def read(ds, p: dict) -> FileData:
         if not has(ds, group, name):
             raise AttitudeInputError(path_of(group, name),
                                      "missing from the file; expected a simkit file with GNSS observations")
+    n_ant = ds[path_of("antennas", "lever_arm_b")].shape[0]
+    if n_ant < 2:  # before the observations: an imported real file has one antenna and no true ambiguities
+        raise AttitudeInputError(path_of("antennas", "lever_arm_b"),
+                                 f"{n_ant} antenna(s); expected at least 2 (one baseline)")
     t_all = read_gnss(ds, satellites=False).t
     sel = np.flatnonzero((t_all >= p["start_s"]) & (t_all <= p["stop_s"]))
     if sel.size == 0:

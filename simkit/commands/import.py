@@ -16,7 +16,7 @@ def add_parser(sub):
                                    "does not know are counted and reported.")
     p.add_argument("obs", help="RINEX observation file")
     p.add_argument("--nav", action="append", default=[], metavar="NAV",
-                   help="RINEX 3/4 navigation file (repeatable): satellite orbits and clocks, Klobuchar")
+                   help="RINEX 3/4 navigation file (repeatable): satellite orbits and clocks, Klobuchar (a path, or the name of a bundled one, as for simkit sky)")
     p.add_argument("-o", "--out", default=None, help="output file (default: OBS name with .h5, here)")
     p.add_argument("--reference", metavar="X,Y,Z", help="reference antenna position, m ECEF")
     p.add_argument("--reference-file", metavar="F", help="file holding the reference position X Y Z, m ECEF")
@@ -33,18 +33,13 @@ def default_out(obs) -> Path:
 
 
 def run(args) -> int:
-    from ..errors import OutputError
     from ..io.output import check_output
     from ..realdata import importer
 
-    if not Path(args.obs).is_file():
-        raise OutputError(args.obs, "no such observation file")
-    for nav in args.nav:
-        if not Path(nav).is_file():
-            raise OutputError(f"--nav {nav}", "no such file")
+    obs, navs = importer.input_files(args.obs, args.nav)
     reference, source = importer.parse_reference(args.reference, args.reference_file)
-    out = check_output(args.out or default_out(args.obs), [args.obs, *args.nav, args.reference_file], option="-o")
-    imported = importer.import_rinex(args.obs, args.nav, reference, source)
+    out = check_output(args.out or default_out(args.obs), [obs, *navs, args.reference_file], option="-o")
+    imported = importer.import_rinex(obs, navs, reference, source)
     importer.write(out, imported)
     if not args.quiet:
         sys.stdout.write(importer.describe(imported, out))

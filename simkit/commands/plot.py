@@ -1,9 +1,10 @@
 """``simkit plot FILE.h5 [--out DIR]``: overview figures of a simkit file as PNGs (needs the ``plot`` extra)."""
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
-from ..errors import ScenarioError
+from ..errors import ScenarioError, SimkitError
 
 
 def add_parser(sub):
@@ -20,7 +21,7 @@ def add_parser(sub):
 def run(args) -> int:
     from tqdm import tqdm
 
-    from ..io import check_output, open_dataset
+    from ..io import check_output, open_dataset, solution_names
     from ..plots import FIGURES, file_figures, require_matplotlib, staged_directory
 
     out = Path(args.out)
@@ -31,8 +32,13 @@ def run(args) -> int:
     check_output(out, [args.file], option="--out", folder=True)
     require_matplotlib("simkit plot")
     open_dataset(args.file).close()
-    with staged_directory(out) as tmp, tqdm(total=len(FIGURES), desc="plot", unit="figure", leave=False) as bar:
-        paths = [p.relative_to(tmp) for p in file_figures(args.file, tmp, bar)]
+    total = len(FIGURES) + len(solution_names(args.file))
+    with staged_directory(out) as tmp, tqdm(total=total, desc="plot", unit="figure", leave=False) as bar:
+        paths = [p.relative_to(tmp) for p in file_figures(args.file, tmp, bar,
+                                                            on_skip=lambda line: bar.write(line, file=sys.stderr))]
+        if not paths:  # raised inside the block: no empty folder is left
+            raise SimkitError(f"{args.file}: no figure drawn: the overview figures need /truth (the Allan "
+                              f"figure /imu), a solution's figures /truth or /reference to score it against")
     for p in paths:
         print(out / p)
     return 0

@@ -28,6 +28,9 @@ def run(args) -> int:
     with open_dataset(args.file) as ds:
         if not has(ds, "gnss", "t"):
             raise DataFileError(args.file, "no /gnss group: the scenario has no [gnss] section")
+        if not has(ds, "gnss_truth", "receiver_clock"):  # the time tags are receiver time: true time + clock
+            raise DataFileError(args.file, "no /gnss/truth/receiver_clock: the RINEX export needs a simulated file "
+                                           "(an imported file's observations are its RINEX file's)")
         try:
             scenario = tomllib.loads(ds.attrs["scenario_toml"])
         except (KeyError, tomllib.TOMLDecodeError) as exc:

@@ -47,7 +47,8 @@ def add_parser(sub):
                         "GPS, BDS, Galileo, QZSS and GLONASS record of the file)")
     p.add_argument("--plot", metavar="OUT.png", help="save a sky plot (needs matplotlib: the 'plot' extra)")
     p.add_argument("--environment", metavar="FILE.toml",
-                   help="a TOML file with an [environment] table (a scenario): the site sees its buildings and "
+                   help="a TOML file with an [environment] table (a scenario, or a bundled scenario's name such as "
+                        "urban_canyon): the site sees its buildings and "
                         "canyons, placed around the file's trajectory.origin (else around the site); the table "
                         "gains counts of direct, direct+reflected, NLOS and blocked satellites, DOPs use the "
                         "received ones and the plot marks each state")
@@ -178,7 +179,12 @@ def _environment(args):
     from ..environment import Environment, parse_config
     from ..section import Section
 
-    path = Path(args.environment)
+    from ..scenario.loader import resolve
+
+    try:
+        path = resolve(args.environment)  # a file, or a bundled scenario's name, as for `simkit run`
+    except ScenarioError as exc:
+        raise ScenarioError("--environment", f"{args.environment}: {exc.message}") from None
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:

@@ -4,7 +4,6 @@ See docs/real_data.md."""
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 
 def add_parser(sub):
@@ -15,7 +14,7 @@ def add_parser(sub):
                                    "--fit estimates simkit's [gnss] error parameters from the real file.")
     p.add_argument("obs", help="RINEX observation file (2.1x, 3.0x, 4.00; plain, gzip or Hatanaka)")
     p.add_argument("--nav", action="append", default=[], metavar="NAV", required=True,
-                   help="RINEX 3/4 navigation file (repeatable)")
+                   help="RINEX 3/4 navigation file (repeatable) (a path, or the name of a bundled one, as for simkit sky)")
     p.add_argument("-o", "--out", default="twin", help="output folder (created; default ./twin)")
     p.add_argument("--fit", action="store_true", help="fit the [gnss] error parameters and run the calibrated twin")
     p.add_argument("--reference", metavar="X,Y,Z", help="receiver position, m ECEF (default: the header's)")
@@ -34,21 +33,18 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..errors import OutputError
     from ..io.output import check_output
     from ..realdata import importer, twin
 
-    for path in [args.obs, *args.nav, *([args.trajectory] if args.trajectory else [])]:
-        if not Path(path).is_file():
-            raise OutputError(path, "no such file")
-    out = check_output(args.out, [args.obs, *args.nav, *([args.trajectory] if args.trajectory else [])], option="-o",
+    obs, navs = importer.input_files(args.obs, args.nav, [args.trajectory])
+    out = check_output(args.out, [obs, *navs, *([args.trajectory] if args.trajectory else [])], option="-o",
                        folder=True, parents=True)
     if not args.no_plots:
         from ..plots import require_matplotlib
 
         require_matplotlib("twin (or --no-plots)")
     reference, source = importer.parse_reference(args.reference, None)
-    fid = twin.run_twin(args.obs, args.nav, out, fit=args.fit, seed=args.seed, reference=reference,
+    fid = twin.run_twin(obs, navs, out, fit=args.fit, seed=args.seed, reference=reference, progress=True,
                         reference_source=source, trajectory=args.trajectory,
                         trajectory_solution=args.trajectory_solution, code_model=args.code_model,
                         realisations=args.realisations, shadowing=not args.no_shadowing)

@@ -53,7 +53,7 @@ def parse_config(sec: Section, origin_lla, base_dir: Path | None = None) -> Envi
     parts, source = [], None
     if sec.has("buildings"):
         source = sec.get("buildings", str)
-        path = _resolve(source, base_dir)
+        path = find_file(source, base_dir)
         if path is None:
             raise sec.error("buildings", f"no such file {source!r} (relative paths are taken from the scenario's "
                             "folder, then the working folder)")
@@ -93,7 +93,8 @@ def check_antennas(cfg: EnvironmentConfig, lever_b: np.ndarray) -> None:
                                     "is inside the box: it would block every satellite")
 
 
-def _resolve(name: str, base_dir: Path | None) -> Path | None:
+def find_file(name: str, base_dir: Path | None) -> Path | None:
+    """The file ``name`` relative to the scenario's folder ``base_dir``, else the working folder; None if neither."""
     for cand in ([base_dir / name] if base_dir is not None else []) + [Path(name)]:
         if cand.is_file():
             return cand

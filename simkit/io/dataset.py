@@ -145,7 +145,10 @@ def open_dataset(path) -> Dataset:
     try:
         f = h5py.File(path, "r")
     except OSError:
-        raise DataFileError(path, "not an HDF5 file") from None
+        with open(path, "rb") as raw:
+            signed = raw.read(8) == b"\x89HDF\r\n\x1a\n"
+        raise DataFileError(path, "a damaged or truncated HDF5 file (an interrupted copy?)" if signed
+                            else "not an HDF5 file") from None
     version = f.attrs.get("schema_version")
     if version is None:
         f.close()

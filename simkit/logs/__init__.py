@@ -15,7 +15,7 @@ from ..trajectory.logged import LoggedPath
 from . import nmea, table, xmltracks
 from .record import Record
 
-__all__ = ["Record", "read", "fit_trajectory", "FORMAT_OF_SUFFIX"]
+__all__ = ["Record", "read", "fit_trajectory", "log_path", "FORMAT_OF_SUFFIX"]
 
 FORMAT_OF_SUFFIX = {".csv": "csv", ".gpx": "gpx", ".nmea": "nmea", ".nma": "nmea", ".log": "nmea",
                     ".kml": "kml", ".kmz": "kmz", ".h5": "h5", ".hdf5": "h5"}
@@ -42,14 +42,21 @@ def read(path, fmt: str | None = None, date_hint=None, solution: str | None = No
     return table.read_solution(path, solution)
 
 
+def log_path(source: str, base: Path | None) -> Path:
+    """The log file of ``[trajectory] source``: as given (the working folder), else relative to the scenario's
+    folder ``base``."""
+    path = Path(source).expanduser()
+    if not path.is_absolute() and base is not None and not path.is_file():
+        path = base / path
+    return path
+
+
 def fit_trajectory(cfg: TrajectoryConfig, base: Path | None, start: datetime, week: int, sow: float,
                    duration_s: float) -> TrajectoryConfig:
     """``cfg`` (with ``cfg.log``) with its log read, cut to the run (scenario start ``week``/``sow``, plus a
     margin) and fitted: ``path`` set, and the origin and initial state taken from the fitted path at t = 0."""
     spec = cfg.log
-    path = Path(spec.source).expanduser()
-    if not path.is_absolute() and base is not None and not path.is_file():
-        path = base / path
+    path = log_path(spec.source, base)
     if not path.is_file():
         raise ScenarioError("trajectory.source", f"no such log file: {spec.source}")
     record = read(path, spec.format, start.date(), spec.solution)

@@ -192,7 +192,8 @@ FIGURES = {"trajectory": _trajectory, "sky": _sky, "satellites_dop": _dops, "imu
 def file_figures(path, out, progress=None, on_skip=skip_line) -> list[Path]:
     """Write every overview figure that ``path`` has the data for, plus one error figure set per stored
     solution (under ``out/solution_<name>/``); returns the PNG paths. A figure or solution that cannot be drawn
-    is left out with one line to ``on_skip``."""
+    is left out with one line to ``on_skip``. ``progress`` (a tqdm bar) advances once per overview figure and
+    once per solution drawn."""
     plt = require_matplotlib()
     out = Path(out)
     paths = []
@@ -201,10 +202,10 @@ def file_figures(path, out, progress=None, on_skip=skip_line) -> list[Path]:
             paths.append(draw(plt, out / f"{name}.png", make, ds, on_skip=on_skip))
             if progress is not None:
                 progress.update(1)
-    return [p for p in paths if p is not None] + _solutions(path, out, on_skip)
+    return [p for p in paths if p is not None] + _solutions(path, out, on_skip, progress)
 
 
-def _solutions(path, out, on_skip) -> list[Path]:
+def _solutions(path, out, on_skip, progress=None) -> list[Path]:
     """The score figures of every stored solution against the truth at its own point."""
     from ..io import read_solution
     from ..referee import read_truth, score
@@ -214,7 +215,11 @@ def _solutions(path, out, on_skip) -> list[Path]:
     names = solution_names(path)
     if not names:
         return paths
-    truth = read_truth(path)
+    try:
+        truth = read_truth(path)
+    except SimkitError as exc:  # a real file without a reference position: nothing to score the solutions against
+        on_skip(f"plot: skipped the figures of {', '.join(f'/solutions/{n}' for n in names)}: {exc}")
+        return paths
     for name in names:
         try:
             sc = score(truth, read_solution(path, name), where=f"/solutions/{name}")
@@ -224,4 +229,6 @@ def _solutions(path, out, on_skip) -> list[Path]:
         folder = out / f"solution_{name}"
         folder.mkdir(exist_ok=True)
         paths += score_figures(sc, folder, f"/solutions/{name}", on_skip)
+        if progress is not None:
+            progress.update(1)
     return paths

@@ -18,6 +18,7 @@ or the position given by the user; the antenna's phase-centre offsets (centimetr
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -45,6 +46,37 @@ class Imported:
     attrs: dict
     group_attrs: dict
     report: dict = field(default_factory=dict)
+
+
+def input_files(obs, navs=(), others=()) -> tuple[Path, list[Path]]:
+    """The observation file and the navigation files of ``simkit import`` / ``simkit twin``, checked before any
+    work: (obs path, nav paths). A navigation file is a path or, as for ``simkit sky``, the name of a bundled
+    data file (:func:`simkit.constellation.sources.resolve`: the documented commands work from any folder).
+    ``others`` (a trajectory log, a reference file) must exist as given. DataFileError names the one missing."""
+    from ..constellation.sources import bundled_files, resolve
+
+    def existing(path, what):
+        p = Path(path)
+        if p.is_dir():
+            raise DataFileError(path, f"is a directory, expected a {what}")
+        if not p.is_file():
+            raise DataFileError(path, f"no such {what}")
+        return p
+
+    nav_paths = []
+    for nav in navs:
+        if Path(nav).is_dir():
+            raise DataFileError(f"--nav {nav}", "is a directory, expected a RINEX navigation file")
+        try:
+            nav_paths.append(resolve(nav))
+        except DataFileError:
+            bundled = [n for n in bundled_files() if re.search(r"\.rnx(\.gz)?$|\.\d\d[nNcCgGlLpP](\.gz)?$", n)]
+            raise DataFileError(f"--nav {nav}", "no such file, and not a bundled navigation file (bundled: "
+                                f"{', '.join(bundled)})") from None
+    for other in others:
+        if other is not None:
+            existing(other, "file")
+    return existing(obs, "RINEX observation file"), nav_paths
 
 
 def parse_reference(text: str | None, file: str | None):

@@ -18,7 +18,7 @@ import numpy as np
 import tomli_w
 
 from .. import gpstime
-from ..errors import ScenarioError
+from ..errors import DataFileError, ScenarioError
 from ..params import parse_value
 from ..imu.config import ImuConfig, parse_config as parse_imu
 from ..section import Section, positive
@@ -73,6 +73,7 @@ class Scenario:
     source: str = ""
     data: dict = field(default_factory=dict)
     overrides: tuple = ()
+    inputs: tuple = ()      # the files a run reads besides the scenario (log, buildings, navigation): never an output
 
 
 def apply_override(data: dict, assignment: str) -> None:
@@ -126,6 +127,8 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
         path = resolve(scenario)
         source, base_dir = str(scenario), path.parent
         try:
+            if path.read_bytes()[:8] == b"\x89HDF\r\n\x1a\n":  # the HDF5 signature: a simulated file, not a scenario
+                raise ScenarioError("", "is an HDF5 file (a simulated one?), expected a scenario TOML file", source)
             text = path.read_text(encoding="utf-8")
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
@@ -146,6 +149,7 @@ def load(scenario: str | Path | dict, overrides: list[str] | None = None, seed: 
 
 def _validate(data: dict, base_dir: Path | None = None) -> Scenario:
     root = Section(data, "")
+    root.only("scenario", "trajectory", "imu", "gnss", "environment")
     meta = root.section("scenario", required=True)
     name = meta.get("name", str, check=lambda v: None if re.fullmatch(r"[\w.-]+", v) else
                     "must be letters, digits, '_', '-' or '.'")
@@ -190,4 +194,29 @@ def _validate(data: dict, base_dir: Path | None = None) -> Scenario:
         check_antennas(env, np.array([a.lever_arm_b for a in gnss.antennas]))
     root.done()
     return Scenario(name=name, description=description, start=start, start_week=week, start_sow=sow,
-                    duration_s=duration, seed=seed, trajectory=traj, imu=imu, gnss=gnss, environment=env)
+                    duration_s=duration, seed=seed, trajectory=traj, imu=imu, gnss=gnss, environment=env,
+                    inputs=_input_files(traj, gnss, env, base_dir))
+
+
+def _input_files(traj, gnss, env, base_dir) -> tuple[Path, ...]:
+    """The files the scenario reads: its trajectory log and buildings (checked above, so they exist) and its
+    constellation files (bundled ones included; a missing one is reported by the constellation stage)."""
+    files = []
+    if traj.log is not None:
+        from ..logs import log_path
+
+        files.append(log_path(traj.log.source, base_dir))
+    if env is not None and env.buildings is not None:
+        from ..environment.config import find_file
+
+        files.append(find_file(env.buildings, base_dir))
+    if gnss is not None:
+        from ..constellation.sources import resolve
+
+        for source in gnss.sources:
+            name = source.split(":", 1)[1] if source.startswith("almanac:") else source
+            try:
+                files.append(None if name.startswith("nominal:") else resolve(name))
+            except DataFileError:
+                pass
+    return tuple(f for f in files if f is not None)
