@@ -88,11 +88,10 @@ def one_blas_thread() -> bool:
 
 def console(argv=None) -> int:
     """The ``simkit`` command and ``python -m simkit``: BLAS on one thread (:func:`one_blas_thread`), :func:`main`,
-    then the process ends at once. The work is
-    done by then (outputs closed and renamed): the standard streams are flushed and the ``atexit`` handlers run,
-    but the interpreter's teardown of every module and object (30-40 ms after a truth + IMU run, more than the
-    file's close) is skipped, as is the kernel's wait for it. While another thread still runs (it would be joined
-    at a normal exit) the exit is the normal one."""
+    then the process ends at once. The work is done by then (outputs closed and renamed): the standard streams are
+    flushed and the ``atexit`` handlers run, but the interpreter's teardown of every module and object (30-40 ms
+    after a truth + IMU run, more than the file's close) is skipped, as is the kernel's wait for it. While another
+    thread still runs (it would be joined at a normal exit) the exit is the normal one."""
     one_blas_thread()
     code = main(argv)
     if threading.active_count() > 1:

@@ -41,7 +41,5 @@ def parse_cn0_report(sec: Section) -> Cn0ReportConfig | None:
 
 def reported(cn0: np.ndarray, z: np.ndarray, cfg: Cn0ReportConfig) -> np.ndarray:
     """The reported C/N0 (dB-Hz) of the true ``cn0`` (dB-Hz) with the unit normals ``z`` (same shape)."""
-    out = cn0 + cfg.sigma_db * z if cfg.sigma_db > 0 else np.array(cn0, dtype=float)
-    if cfg.resolution_dbhz > 0:
-        out = np.round(out / cfg.resolution_dbhz) * cfg.resolution_dbhz
-    return out
+    out = cn0 + cfg.sigma_db * z if cfg.sigma_db > 0 else cn0
+    return np.round(out / cfg.resolution_dbhz) * cfg.resolution_dbhz if cfg.resolution_dbhz > 0 else out

@@ -261,14 +261,20 @@ def cn0_comparison(real_cn0: dict, twin_cn0s: list, el, edges_deg) -> dict:
                          "real_satellites": a["satellites"], "real_se": a["se"], "twin_dbhz": b["mean"],
                          "twin_se": b["se"], "difference": d, "difference_se": se, "real_sd_db": sd_r,
                          "twin_sd_db": sd_t})
-        d, e = np.array(diffs), np.array(ses)
-        out[s] = {"bins": rows, "bias_dbhz": float(d.mean()) if d.size else None,
-                  "scatter_dbhz": float(d.std()) if d.size else None,
-                  "rms_dbhz": float(np.sqrt(np.mean(d ** 2))) if d.size else None,
-                  "rms_se_dbhz": float(np.sqrt(np.mean(e ** 2))) if d.size else None,
-                  "chi2_per_bin": float(np.mean((d / e) ** 2)) if d.size and (e > 0).all() else None,
+        out[s] = {"bins": rows, **_differences(diffs, ses),
                   "spread_rms_db": float(np.sqrt(np.mean(np.square(spread)))) if spread else None}
     return out
+
+
+def _differences(diffs: list, ses: list) -> dict:
+    """Bias (mean), scatter (std) and RMS of the per-bin differences ``diffs`` (dB-Hz), the RMS of their standard
+    errors ``ses`` and the mean squared difference in standard errors (chi-square per bin); None each when empty."""
+    d, e = np.array(diffs), np.array(ses)
+    if not d.size:
+        return dict.fromkeys(("bias_dbhz", "scatter_dbhz", "rms_dbhz", "rms_se_dbhz", "chi2_per_bin"))
+    return {"bias_dbhz": float(d.mean()), "scatter_dbhz": float(d.std()), "rms_dbhz": float(np.sqrt(np.mean(d ** 2))),
+            "rms_se_dbhz": float(np.sqrt(np.mean(e ** 2))),
+            "chi2_per_bin": float(np.mean((d / e) ** 2)) if (e > 0).all() else None}
 
 
 def cn0_drift(bins: list, other_cn0, el_other) -> dict:
@@ -292,12 +298,9 @@ def cn0_drift(bins: list, other_cn0, el_other) -> dict:
             continue
         diffs.append(b["real_dbhz"] - o["mean"])
         ses.append(float(np.hypot(b["real_se"], o["se"])))
-    d, e = np.array(diffs), np.array(ses)
-    if not d.size:
+    if not diffs:
         return {"bins": 0}
-    return {"bins": int(d.size), "bias_dbhz": float(d.mean()), "scatter_dbhz": float(d.std()),
-            "rms_dbhz": float(np.sqrt(np.mean(d ** 2))), "rms_se_dbhz": float(np.sqrt(np.mean(e ** 2))),
-            "chi2_per_bin": float(np.mean((d / e) ** 2)) if (e > 0).all() else None}
+    return {"bins": len(diffs), **_differences(diffs, ses)}
 
 
 def drift(per_signal: dict, other_mp: dict, el_other, tol: float = TOLERANCE) -> dict:
