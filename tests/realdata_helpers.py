@@ -13,6 +13,8 @@ KMS3_OBS = OBS / "KMS300DNK_R_20221591000_01H_30S_MO.crx"
 KMS3_NAV = NAV / "KMS300DNK_R_20221591000_01H_MN.rnx.gz"
 BERLIN_OBS = OBS / "Berlin_Potsdamer_Platz_60ep.obs"
 BERLIN_NAV = NAV / "BRDC00WRD_U_20161580000_01D_MN.rnx.gz"
+CN00_OBS = OBS / "cn000010.21o"            # 3 h 40 min of a static CORS station with C/N0 (tests/data/SOURCES.md)
+CN00_NAV = ROOT / "tests" / "data" / "rinex_nav" / "brdc0010.21n"   # RINEX 2.11 GPS, its day's first hours
 KMS3_HEADER_POS = np.array([3516213.4380, 781859.8595, 5246037.9660])  # APPROX POSITION XYZ, delta H/E/N zero
 
 

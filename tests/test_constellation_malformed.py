@@ -98,3 +98,36 @@ def test_unknown_format_missing_file_and_unknown_nominal(tmp_path):
         load(tmp_path / "absent.rnx")
     with pytest.raises(DataFileError, match="nominal:gps"):
         load("nominal:galileo")
+
+
+RNX2 = Path(__file__).parent / "data" / "rinex_nav" / "brdc0010.21n"   # RINEX 2.11 GPS (tests/data/SOURCES.md)
+
+
+def _first_record(lines) -> int:
+    return next(i for i, ln in enumerate(lines) if "END OF HEADER" in ln) + 1
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda ln: ln[:2] + " 2O" + ln[5:], "RINEX 2 satellite number and epoch"),      # a letter in the year
+    (lambda ln: ln[:17] + " 12.5" + ln[22:], "not whole"),                        # a clock epoch off the second
+    (lambda ln: ln[:22] + "-5.6086713X4817D-04" + ln[41:], "expected a number"),  # a bad clock term
+])
+def test_rinex2_bad_record_start_names_its_line(tmp_path, edit, words):
+    lines = _lines(RNX2)
+    k = _first_record(lines) + 8 * 5        # the sixth record's first line
+    lines[k] = edit(lines[k])
+    err = _error(_write(tmp_path, "bad.21n", lines))
+    assert err.line == k + 1 and words in err.message
+
+
+def test_rinex2_truncated_record_and_header(tmp_path):
+    lines = _lines(RNX2)
+    k = _first_record(lines) + 8 * 3
+    err = _error(_write(tmp_path, "cut.21n", lines[:k + 5]))   # the file ends inside the fourth record
+    assert err.line == k + 1 and "truncated" in err.message
+    h = next(i for i, ln in enumerate(lines) if ln[60:].strip() == "ION BETA")
+    lines[h] = lines[h][:26] + " " * 12 + lines[h][38:]                 # a blank third beta coefficient
+    err = _error(_write(tmp_path, "beta.21n", lines))
+    assert err.line == h + 1 and "ION BETA coefficient 2" in err.message
+    lines[0] = "     1.00" + lines[0][9:]
+    assert "2.1x, 3.0x or 4.0x" in _error(_write(tmp_path, "v1.21n", lines)).message

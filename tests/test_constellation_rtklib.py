@@ -14,7 +14,8 @@ from conftest import DATA as _DATA
 from rtklib_nav import gpst, kepler_against_rtklib, rtklib_nav, sat_id
 
 DATA = _DATA / "rinex_nav"
-FILES = ["BRDM00DLR_S_20261170000_01D_MN.rnx.gz", "BRDC00WRD_U_20161580000_01D_MN.rnx", "cubb1870.15c"]
+FILES = ["BRDM00DLR_S_20261170000_01D_MN.rnx.gz", "BRDC00WRD_U_20161580000_01D_MN.rnx", "cubb1870.15c",
+         "brdc0010.21n"]
 
 
 @pytest.mark.parametrize("name", FILES)
@@ -50,5 +51,16 @@ def test_eph2pos_agreement(name, tmp_path):
     assert dclk.max() < 1e-12
     expected = {"BRDM00DLR_S_20261170000_01D_MN.rnx.gz": {"GMEO", "CGEO", "CIGSO", "CMEO"},
                 "BRDC00WRD_U_20161580000_01D_MN.rnx": {"GMEO", "CGEO", "CIGSO", "CMEO"},
-                "cubb1870.15c": {"CGEO", "CIGSO", "CMEO"}}[name]
+                "cubb1870.15c": {"CGEO", "CIGSO", "CMEO"}, "brdc0010.21n": {"GMEO"}}[name]
     assert expected <= set(kinds.tolist())
+
+
+def test_rinex2_header_klobuchar_and_utc_as_rtklib_reads_them(tmp_path):
+    """ION ALPHA / ION BETA and DELTA-UTC of a RINEX 2.11 GPS file: the coefficients RTKLIB's readrnx keeps."""
+    src = DATA / "brdc0010.21n"
+    const = load(src)
+    nav = rtklib_nav(src, tmp_path)
+    k = const.klobuchar["G"]
+    np.testing.assert_array_equal(np.concatenate([k.alpha, k.beta]), [nav.ion_gps[i] for i in range(8)])
+    utc = const.time_offsets["GPUT"]
+    assert (utc.a0, utc.a1, utc.t_ref[1], utc.t_ref[0]) == tuple(nav.utc_gps[i] for i in range(4))

@@ -120,6 +120,47 @@ def test_a_receivers_cn0_offset_moves_that_signals_cn0_and_its_noise(tmp_path):
                                rtol=1e-9)
 
 
+def test_a_cn0_offset_table_sets_that_signals_cn0_by_the_angle_from_boresight(tmp_path):
+    """[gnss.cn0_offset_db] L2W = {off_boresight_deg, offset_db}: L2W's C/N0 is the pattern's plus the table's
+    value at the angle from boresight (linear in between, end values beyond); L1C untouched bit for bit."""
+    from simkit.gnss import signals as sigmod
+
+    pattern = {"off_boresight_deg": [0.0, 40.0, 80.0], "gain_db": [2.0, -1.0, -15.0]}
+    table = {"off_boresight_deg": [40.0, 60.0, 80.0], "offset_db": [-1.0, -4.0, -12.0]}
+    sc = _scenario({})
+    sc["gnss"]["antenna"] = [{"lever_arm_m": [0.0, 0.0, 0.0], "gain_pattern": pattern}]
+    sc["gnss"]["cn0_zenith_dbhz"] = 44.0
+    base = run(sc, out=tmp_path / "a.h5")
+    sc["gnss"]["cn0_offset_db"] = {"L2W": table}
+    moved = run(sc, out=tmp_path / "b.h5")
+    with open_dataset(base) as a, open_dataset(moved) as b:
+        ga = read_gnss(a, antennas=0, obs=("cn0",), truth=("elevation",))
+        gb = read_gnss(b, antennas=0, obs=("cn0",), truth=("elevation",))
+    off = 90.0 - np.degrees(gb.truth["elevation"])
+    on = np.isfinite(gb.obs["cn0"]["L2W"])
+    assert on.sum() > 1000 and off[on].min() < 40.0 and off[on].max() > 80.0   # before the first node and past the last
+    expected = 44.0 + sigmod.get("L2W").cn0_offset_db + np.interp(off[on], pattern["off_boresight_deg"],
+                                                                   pattern["gain_db"]) \
+        + np.interp(off[on], table["off_boresight_deg"], table["offset_db"])
+    np.testing.assert_allclose(gb.obs["cn0"]["L2W"][on], expected, atol=1e-9)
+    assert np.array_equal(gb.obs["cn0"]["L1C"], ga.obs["cn0"]["L1C"], equal_nan=True)
+
+
+@pytest.mark.parametrize("table, key, words", [
+    ({"off_boresight_deg": [10.0, 5.0], "offset_db": [1.0, 2.0]}, "L2W.off_boresight_deg", "increasing"),
+    ({"off_boresight_deg": [10.0, 190.0], "offset_db": [1.0, 2.0]}, "L2W.off_boresight_deg", "[0, 180]"),
+    ({"off_boresight_deg": [10.0, 20.0], "offset_db": [1.0]}, "L2W.offset_db", "one offset_db per"),
+    ({"off_boresight_deg": [10.0], "offset_db": [-31.0]}, "L2W.offset_db", "[-30.0, 30.0]"),
+    ({"elevation_deg": [10.0], "offset_db": [1.0]}, "L2W.off_boresight_deg", "missing"),
+])
+def test_a_malformed_cn0_offset_table_is_one_error_naming_the_key(table, key, words):
+    sc = _scenario({})
+    sc["gnss"]["cn0_offset_db"] = {"L2W": table}
+    with pytest.raises(ScenarioError) as e:
+        load(sc)
+    assert f"gnss.cn0_offset_db.{key}" in str(e.value) and words in str(e.value)
+
+
 @pytest.mark.parametrize("table, words", [({"L2W": 45.0}, "[-30.0, 30.0]"), ({"L5Q": 1.0}, "unknown key"),
                                           ({"L1C": "high"}, "L1C")])
 def test_a_malformed_cn0_offset_is_one_error_naming_the_key(table, words):

@@ -117,6 +117,46 @@ def test_cn0_fit_recovers_the_simulator_model():
     assert p["cn0_zenith_dbhz"] == pytest.approx(42.0, abs=0.2) and p["rolloff_db"] == pytest.approx(14.0, abs=0.4)
 
 
+def _two_signal_cn0(l2_rolloff_db, seed=4):
+    """A synthetic static file whose L1C C/N0 follows the quadratic model and whose L2W falls by a further
+    ``l2_rolloff_db`` (theta / 90 deg)^2 below it (plus a constant 3 dB), 0.3 dB-Hz white noise on both."""
+    rng = np.random.default_rng(seed)
+    m, s = 120, 10
+    el = np.radians(rng.uniform(5, 85, (m, s)))
+    x = ((np.pi / 2 - el) / (np.pi / 2)) ** 2
+    l2 = sigmod.get("L2W")
+    t, obs = _dual(m=m, s=s)
+    real = {"t": t, "signals": ["L1C", "L2W"], "freq": [L1.freq_hz, l2.freq_hz],
+            "sat_freq": np.tile([L1.freq_hz, l2.freq_hz], (s, 1)), "obs": {k: dict(obs[k]) for k in twin.KINDS}}
+    real["obs"]["cn0"] = {"L1C": 48.0 + L1.cn0_offset_db - 14.0 * x + 0.3 * rng.standard_normal((m, s)),
+                          "L2W": 48.0 + l2.cn0_offset_db - 3.0 - (14.0 + l2_rolloff_db) * x
+                          + 0.3 * rng.standard_normal((m, s))}
+    ref = np.array([6378137.0, 0.0, 0.0])
+    real["sat_pos"] = ref + 2.0e7 * (np.cos(el)[..., None] * np.array([0.0, 1.0, 0.0])
+                                     + np.sin(el)[..., None] * np.array([1.0, 0.0, 0.0]))
+    return real, ref
+
+
+def test_a_signal_falling_faster_with_elevation_gets_its_own_cn0_table():
+    """L2W 10 dB further down at the horizon than L1C: the fit keeps L1C's pattern as the antenna's and writes
+    L2W's offset by the angle from boresight, -3 dB at boresight to -13 dB at 90 deg, within 0.5 dB at every node;
+    the scenario fragment carries it as a table."""
+    real, ref = _two_signal_cn0(10.0)
+    p = twin.fit_parameters(real, ref)
+    off, val = p["cn0_offset_table"]["L2W"]
+    expected = -3.0 - 10.0 * (np.array(off) / 90.0) ** 2
+    np.testing.assert_allclose(val, expected, atol=0.5)
+    entry = twin.cn0_offset_entries(p)["L2W"]
+    assert entry["off_boresight_deg"] == list(off) and "offset_db = [" in twin.toml_fragment(p)
+
+
+def test_signals_with_one_pattern_keep_a_single_offset():
+    real, ref = _two_signal_cn0(0.0)
+    p = twin.fit_parameters(real, ref)
+    assert "cn0_offset_table" not in p and p["cn0_offset_db"]["L2W"] == pytest.approx(-3.0, abs=0.2)
+    assert twin.cn0_offset_entries(p) == {"L2W": p["cn0_offset_db"]["L2W"]}
+
+
 @pytest.mark.slow
 def test_twin_of_kms3_with_fit(tmp_path, capsys):
     out = tmp_path / "twin"
@@ -214,6 +254,13 @@ def test_the_fitted_fragment_is_a_valid_gnss_section(tmp_path):
     as_json = json.loads(json.dumps(dict(twin.DEFAULTS, code_error_scale=tables)))
     assert twin.toml_fragment(as_json) == twin.toml_fragment(dict(twin.DEFAULTS, code_error_scale=tables))
     assert loaded.gnss.multipath.carrier_sigma_m == pytest.approx(0.01)
+    # a signal's C/N0 offset by the angle from boresight: a table in the fragment, the same table loaded
+    offsets = dict(twin.DEFAULTS, cn0_offset_db={"L2W": -3.0},
+                   cn0_offset_table={"L2W": ((0.0, 45.0, 90.0), (-3.0, -5.5, -13.0))})
+    sc["gnss"]["cn0_offset_db"] = tomllib.loads(twin.toml_fragment(offsets))["gnss"]["cn0_offset_db"]
+    assert load(sc).gnss.cn0_offset_db == {"L2W": ((0.0, 45.0, 90.0), (-3.0, -5.5, -13.0))}
+    as_json = json.loads(json.dumps(offsets))
+    assert twin.toml_fragment(as_json) == twin.toml_fragment(offsets)
 
 
 def test_the_fragment_with_truth_errors_acquisition_and_cn0_step_loads():

@@ -16,7 +16,7 @@ def add_parser(sub):
                                    "does not know are counted and reported.")
     p.add_argument("obs", help="RINEX observation file")
     p.add_argument("--nav", action="append", default=[], metavar="NAV",
-                   help="RINEX 3/4 navigation file (repeatable): satellite orbits and clocks, Klobuchar (a path, or the name of a bundled one, as for simkit sky)")
+                   help="RINEX 2/3/4 navigation file (repeatable): satellite orbits and clocks, Klobuchar (a path, or the name of a bundled one, as for simkit sky)")
     p.add_argument("-o", "--out", default=None, help="output file (default: OBS name with .h5, here)")
     p.add_argument("--reference", metavar="X,Y,Z", help="reference antenna position, m ECEF")
     p.add_argument("--reference-file", metavar="F", help="file holding the reference position X Y Z, m ECEF")

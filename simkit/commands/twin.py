@@ -14,7 +14,7 @@ def add_parser(sub):
                                    "--fit estimates simkit's [gnss] error parameters from the real file.")
     p.add_argument("obs", help="RINEX observation file (2.1x, 3.0x, 4.00; plain, gzip or Hatanaka)")
     p.add_argument("--nav", action="append", default=[], metavar="NAV", required=True,
-                   help="RINEX 3/4 navigation file (repeatable) (a path, or the name of a bundled one, as for simkit sky)")
+                   help="RINEX 2/3/4 navigation file (repeatable) (a path, or the name of a bundled one, as for simkit sky)")
     p.add_argument("-o", "--out", default="twin", help="output folder (created; default ./twin)")
     p.add_argument("--fit", action="store_true", help="fit the [gnss] error parameters and run the calibrated twin")
     p.add_argument("--reference", metavar="X,Y,Z", help="receiver position, m ECEF (default: the header's)")

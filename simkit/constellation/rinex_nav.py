@@ -1,5 +1,11 @@
-"""RINEX 3.0x / 4.00 navigation files -> broadcast ephemeris constellation (GPS LNAV, BDS D1/D2, Galileo I/NAV
-and F/NAV, QZSS LNAV, GLONASS FDMA state vectors).
+"""RINEX 2.1x / 3.0x / 4.00 navigation files -> broadcast ephemeris constellation (GPS LNAV, BDS D1/D2, Galileo
+I/NAV and F/NAV, QZSS LNAV, GLONASS FDMA state vectors).
+
+RINEX 2 files hold one system each: GPS ('N: GPS NAV DATA', the IGS ``brdcDDD0.YYn`` files) or GLONASS ('G'); their
+body is rewritten line for line in the RINEX 3 layout (satellite id with its letter, four-digit year, values one
+column to the right) and read as RINEX 3, so line numbers in errors are the file's own. Two-digit years 80-99 are
+19xx, 00-79 20xx (RINEX 2.11 section 6.10); the header's ION ALPHA / ION BETA give the GPS Klobuchar coefficients
+and DELTA-UTC the GPS-UTC offset.
 
 Mixed multi-GNSS files are accepted; GPS, BDS, Galileo, QZSS and GLONASS records are kept (SBAS and NavIC are
 skipped), or only the systems named in ``systems``. Galileo: I/NAV and F/NAV records are both read; a satellite's
@@ -50,8 +56,12 @@ _CNV_DELAYS = {"CNV1": {24: "ISC_B1Cd", 26: "TGD_B1Cp", 27: "TGD_B2ap"},
 
 
 def is_rinex_nav(lines: list[str]) -> bool:
-    """True when the first line is a RINEX navigation 'RINEX VERSION / TYPE' header."""
-    return bool(lines) and "RINEX VERSION / TYPE" in lines[0] and lines[0][20:21] == "N"
+    """True when the first line is a RINEX navigation 'RINEX VERSION / TYPE' header (any version; RINEX 2
+    GLONASS files are type 'G')."""
+    if not lines or "RINEX VERSION / TYPE" not in lines[0]:
+        return False
+    kind = lines[0][20:21]
+    return kind == "N" or kind == "G" and lines[0][:9].strip().startswith("2")
 
 
 def _sat_id(text: str) -> str:
@@ -91,13 +101,24 @@ def _header(lines, path):
     if not is_rinex_nav(lines):
         raise DataFileError(path, "not a RINEX navigation file (no 'RINEX VERSION / TYPE' with type N)", 1)
     version = number(lines[0][:9], path, 1, "RINEX version", blank=None)
-    if not 3.0 <= version < 5.0:
-        raise DataFileError(path, f"RINEX navigation version {version} is not supported (3.0x or 4.0x)", 1)
+    if not 2.0 <= version < 5.0:
+        raise DataFileError(path, f"RINEX navigation version {version} is not supported (2.1x, 3.0x or 4.0x)", 1)
     klob = {}
     for i, line in enumerate(lines):
         label = line[60:].strip()
         if label == "END OF HEADER":
             return i + 1, version, klob
+        if version < 3.0 and label in ("ION ALPHA", "ION BETA"):
+            vals = np.array([number(line[2 + 12 * k: 14 + 12 * k], path, i + 1, f"{label} coefficient {k}",
+                                    blank=None) for k in range(4)])
+            entry = klob.setdefault("G", Klobuchar(np.full(4, np.nan), np.full(4, np.nan)))
+            setattr(entry, "alpha" if label == "ION ALPHA" else "beta", vals)
+        if version < 3.0 and label == "DELTA-UTC: A0,A1,T,W":
+            klob.setdefault("_sto", {})["GPUT"] = TimeOffset(
+                "GPUT", number(line[3:22], path, i + 1, "A0", blank=None),
+                number(line[22:41], path, i + 1, "A1", blank=None),
+                (int(number(line[50:59], path, i + 1, "reference week W", blank=None)),
+                 number(line[41:50], path, i + 1, "reference time T", blank=None)))
         if label == "TIME SYSTEM CORR" and line[:4].strip():
             klob.setdefault("_sto", {}).setdefault(line[:4], TimeOffset(
                 line[:4], number(line[5:22], path, i + 1, "a0"), number(line[22:38], path, i + 1, "a1"),
@@ -206,13 +227,41 @@ def read(path, raw: bytes | None = None, systems: str | None = None):
     raw = read_bytes(path) if raw is None else raw
     head_end = raw.find(b"END OF HEADER")
     head_end = len(raw) if head_end < 0 else raw.find(b"\n", head_end) + 1 or len(raw)
-    start, version, klob = _header(lines_of(raw[:head_end]) + [""], path)
+    head = lines_of(raw[:head_end]) + [""]
+    start, version, klob = _header(head, path)
+    if version < 3.0:
+        raw = _rinex2_as_rinex3(raw, start, "R" if head[0][20:21] == "G" else "G", path)
     body = _rinex3_body if version < 4.0 else _rinex4_body
     ids, vals, delays, fnav, glo = body(raw, start, path, systems, klob)
     offsets = klob.pop("_sto", {})
     const = _assemble(path, klob, ids, vals, delays, fnav, glo, systems)
     const.time_offsets = offsets
     return const
+
+
+def _rinex2_as_rinex3(raw: bytes, start: int, letter: str, path) -> bytes:
+    """A RINEX 2 GPS (``letter`` 'G') or GLONASS ('R') navigation file with its body rewritten in the RINEX 3
+    layout, line for line: a record's first line 'PP YY MM DD HH MM SS.S' + 3 values becomes 'GPP YYYY MM DD HH MM
+    SS' + the same values; an orbit line (3 blanks, 4 values) gains a leading blank."""
+    lines = raw.decode("latin-1").splitlines()
+    out = lines[:start]
+    for i in range(start, len(lines)):
+        line = lines[i]
+        if not line.strip() or not line[:3].strip():
+            out.append(" " + line if line.strip() else line)
+            continue
+        try:
+            prn = int(line[0:2])
+            yy, mo, dd, hh, mi = (int(line[2 + 3 * k: 5 + 3 * k]) for k in range(5))
+            sec = float(line[17:22])
+        except ValueError:
+            raise DataFileError(path, f"bad record start {line[:22].strip()!r}: expected the RINEX 2 satellite "
+                                "number and epoch 'PP YY MM DD HH MM SS.S'", i + 1) from None
+        if sec != int(sec):
+            raise DataFileError(path, f"clock epoch seconds {sec} are not whole: not a broadcast record", i + 1)
+        year = yy + (1900 if yy >= 80 else 2000)
+        out.append(f"{letter}{prn:02d} {year:04d} {mo:02d} {dd:02d} {hh:02d} {mi:02d} {int(sec):02d}{line[22:]}")
+    return ("\n".join(out) + "\n").encode("latin-1")
 
 
 def _assemble(path, klob, ids, vals, delays, fnav, glo, systems):

@@ -74,5 +74,5 @@ def load(source, *, validity_days: float | None = None, systems: str | None = No
         return almanac.read_sem(path, lines, **kw)
     if tle.is_tle(lines):
         return tle.read(path, lines, **kw)
-    raise DataFileError(path, "unknown format: expected RINEX 3/4 navigation, YUMA or SEM almanac, "
+    raise DataFileError(path, "unknown format: expected RINEX 2/3/4 navigation, YUMA or SEM almanac, "
                         "GSC Galileo XML almanac, or TLEs", 1)

@@ -89,7 +89,7 @@ class GnssConfig:
     ambiguity_max_cycles: int
     iono_coefficients: dict[str, tuple] = field(default_factory=dict)  # "gps"/"bds" -> (alpha, beta) overrides
     code_error_scale: dict = field(default_factory=dict)  # signal -> factor (or (el_deg, factor) table) on code noise + multipath
-    cn0_offset_db: dict = field(default_factory=dict)  # signal -> dB added to the signal table's C/N0 offset
+    cn0_offset_db: dict = field(default_factory=dict)  # signal -> dB (or (off_boresight_deg, dB) table) added to the table's C/N0 offset
     truth_errors: TruthErrorsConfig | None = None  # departures of the truth from the receiver's models; None: off
     acquisition: AcquisitionConfig = field(default_factory=AcquisitionConfig)  # rising satellites' first track
     shadowing: ShadowingConfig | None = None  # stochastic street shadowing / blockage of C/N0; None: off
@@ -265,28 +265,47 @@ def _code_scale(cs: Section, sigs: list[str]) -> dict:
 def _cn0_offset(cs: Section, sigs: list[str]) -> dict:
     """[gnss.cn0_offset_db]: signal name -> dB (in [-30, 30]) added to that signal's C/N0 offset of the signal
     table: the C/N0 a receiver reports differs by system and code beyond the received power (its correlator
-    losses, its estimator; ``simkit twin --fit`` estimates them)."""
-    out = {name: cs.get(name, float, None, check=in_range(-30.0, 30.0)) for name in sigs}
+    losses, its estimator; ``simkit twin --fit`` estimates them). A number, or a table ``{off_boresight_deg =
+    [...], offset_db = [...]}`` (increasing angles in [0, 180], linear in between, the end values beyond), kept as
+    the pair of tuples: a signal whose C/N0 falls with the angle faster than the antenna pattern says (the
+    semi-codeless tracking of GPS L2 P(Y) loses more at low C/N0, and an antenna's gain differs by frequency)."""
+    out = {}
+    for name in sigs:
+        if isinstance(cs.data.get(name), dict):
+            out[name] = _angle_table(cs.section(name), "off_boresight_deg", (0.0, 180.0), "offset_db",
+                                     in_range(-30.0, 30.0))
+            continue
+        value = cs.get(name, float, None, check=in_range(-30.0, 30.0))
+        if value is not None:
+            out[name] = value
     cs.done()
-    return {k: v for k, v in out.items() if v is not None}
+    return out
 
 
 def _code_scale_table(t: Section) -> tuple:
-    el = t.get("elevation_deg", float, shape=0)
-    factor = t.get("factor", float, shape=0)
-    if not el or len(el) != len(factor):
-        raise t.error("factor", f"expected one factor per elevation ({len(el)}), got {len(factor)}")
-    if any(b <= a for a, b in zip(el, el[1:])) or not all(-90.0 <= e <= 90.0 for e in el):
-        raise t.error("elevation_deg", f"expected increasing elevations in [-90, 90], got {el!r}")
-    if any(f < 0 for f in factor):
-        raise t.error("factor", f"must be >= 0, got {factor!r}")
+    return _angle_table(t, "elevation_deg", (-90.0, 90.0), "factor", non_negative)
+
+
+def _angle_table(t: Section, angle_key: str, bounds: tuple, value_key: str, check) -> tuple:
+    """A table of values against an angle (deg): (angles, values), the angles increasing within ``bounds``, one
+    value per angle, each passing ``check`` (a Section check: None or the complaint)."""
+    ang = t.get(angle_key, float, shape=0)
+    vals = t.get(value_key, float, shape=0)
+    if not ang or len(ang) != len(vals):
+        raise t.error(value_key, f"expected one {value_key} per {angle_key} entry ({len(ang)}), got {len(vals)}")
+    if any(b <= a for a, b in zip(ang, ang[1:])) or not all(bounds[0] <= a <= bounds[1] for a in ang):
+        raise t.error(angle_key, f"expected increasing angles in [{bounds[0]:g}, {bounds[1]:g}], got {ang!r}")
+    for v in vals:
+        complaint = check(v)
+        if complaint:
+            raise t.error(value_key, f"{complaint}, got {vals!r}")
     t.done()
-    return tuple(el), tuple(factor)
+    return tuple(ang), tuple(vals)
 
 
-def code_scale_at(scale, el_rad):
-    """The factor of a ``code_error_scale`` entry (a number or an (elevation_deg, factor) pair) at elevations
-    ``el_rad`` (rad, any shape)."""
+def angle_table_at(scale, el_rad):
+    """The value of a ``code_error_scale`` or ``cn0_offset_db`` entry (a number or an (angle_deg, value) pair) at
+    the angles ``el_rad`` (rad, any shape: elevations for the first, off-boresight angles for the second)."""
     if not isinstance(scale, tuple):
         return scale
     return np.interp(np.degrees(el_rad), scale[0], scale[1])

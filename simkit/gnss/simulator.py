@@ -38,7 +38,7 @@ from ..errors import DataFileError, ScenarioError
 from . import atmosphere, cn0_report, noise, signals as sigmod, tworay
 from .acquisition import Acquisition
 from .clock import ClockProcess
-from .config import GnssConfig, check_sats, code_scale_at
+from .config import GnssConfig, check_sats, angle_table_at
 from .draws import KeyedNormals
 from .ephemeris_errors import EphemerisErrors
 from .ionex import read_ionex
@@ -510,11 +510,12 @@ class _Parts:
         cols = self.cand[cj]
         cj = consecutive(cj)   # one system's columns: views, not copies
         rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
-        cn0_off = g.cn0_offset_db + cfg.cn0_offset_db.get(g.name, 0.0)
+        cn0_off = g.cn0_offset_db + angle_table_at(cfg.cn0_offset_db.get(g.name, 0.0), off[..., cj])
         cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, cn0_off)
         for a, ant in enumerate(cfg.antennas):
             if ant.gain_pattern is not None:
-                cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern, cn0_off)
+                cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern,
+                                                   cn0_off[:, a] if np.ndim(cn0_off) else cn0_off)
         if self.shadow is not None:
             cn0 = cn0 - self.shadow.attenuation_db[..., cj]
         freq = sim.freq[cols, j]                                                    # (C,) Hz
@@ -523,7 +524,7 @@ class _Parts:
         scale = (atmosphere.reference_frequency(g.system) / freq) ** 2
         iono, iono_rate = self.iono[..., cj] * scale, self.iono_rate[..., cj] * scale
         el = self.el[..., cj]
-        code_scale = code_scale_at(cfg.code_error_scale.get(g.name, 1.0), el)
+        code_scale = angle_table_at(cfg.code_error_scale.get(g.name, 1.0), el)
         sig_c = sig_c * code_scale
         if self.mp is not None:
             mp_c = elevation_scale(el, cfg.multipath.code_sigma_m * code_scale, cfg.multipath.elevation_scale_rad) * \

@@ -337,7 +337,7 @@ def smooth_correction(per_signal: dict, current: dict, nodes_deg=tuple(range(0, 
     bins too uncertain to show a trend, give a level only.
     Code noise and code multipath are both linear in the factor, so the correction moves the twin's expected
     sigma onto the real one's smooth trend, not onto each bin's sampling scatter."""
-    from ..gnss.config import code_scale_at
+    from ..gnss.config import angle_table_at
 
     out = {}
     nodes = np.asarray(nodes_deg, float)
@@ -351,6 +351,6 @@ def smooth_correction(per_signal: dict, current: dict, nodes_deg=tuple(range(0, 
         a_mat = np.stack([np.ones_like(x), x], axis=1) * np.sqrt(w)[:, None]
         lhs = a_mat.T @ a_mat + np.diag([0.0, slope_prior ** -2])
         a, b = np.linalg.solve(lhs, a_mat.T @ (y * np.sqrt(w)))
-        now = np.broadcast_to(code_scale_at(current.get(s, 1.0), np.radians(nodes)), nodes.shape)
+        now = np.broadcast_to(angle_table_at(current.get(s, 1.0), np.radians(nodes)), nodes.shape)
         out[s] = (tuple(float(n) for n in nodes), tuple(float(f) for f in now / np.exp(a + b * (nodes - 45) / 45)))
     return out

@@ -23,7 +23,7 @@ from ..earth import C_LIGHT
 from ..errors import InputError
 from ..gnss import noise as noise_model
 from ..gnss import signals as sigmod
-from ..gnss.config import code_scale_at
+from ..gnss.config import angle_table_at
 from . import acquisition, fidelity, horizon, importer, ionosphere, noise_fit, shadowing_fit, sisre
 
 KINDS = ("code", "carrier", "doppler", "cn0", "lli")
@@ -103,7 +103,7 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                                  if p.get("gain_pattern") else {"rolloff_db": p["rolloff_db"]})}],
                  "noise": {"dll_bandwidth_hz": p["dll_bandwidth_hz"], "pll_bandwidth_hz": p["pll_bandwidth_hz"],
                            "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
-                 "cn0_offset_db": dict(p.get("cn0_offset_db", {})),
+                 "cn0_offset_db": cn0_offset_entries(p),
                  "code_error_scale": {k: {"elevation_deg": list(v[0]), "factor": list(v[1])}
                                       if isinstance(v, (tuple, list)) else v
                                       for k, v in p.get("code_error_scale", {}).items()},
@@ -309,7 +309,66 @@ def _fit_cn0(real, sigs, el, p) -> bool:
     p["rolloff_db"] = float(max(sol[1], 0.0))
     p["cn0_offset_db"] = {n: float(np.clip(v, -30.0, 30.0)) for n, v in zip(names[1:], sol[2:])}
     p["gain_pattern"] = _gain_pattern(real, sigs, el, p)
+    if not real.get("trajectory"):     # at a street the bins' levels are the street's (the shadowing fit's)
+        _signal_patterns(real, [g for g in sigs if g.name in names], el, p)
     return True
+
+
+# a signal's C/N0 levels per bin differ from the shared pattern beyond sampling when the chi-square of the
+# differences in their standard errors has a p-value under this
+SIGNAL_PATTERN_P = 1e-3
+
+
+def _signal_patterns(real, sigs, el, p) -> None:
+    """Per-signal C/N0 offset tables of a fixed antenna, where one gain pattern does not serve every signal.
+
+    Each signal's mean C/N0 (less its offset) per 10-degree bin is compared with the shared pattern's level there,
+    in the bins' standard errors (:func:`noise_fit.bin_mean`: the jackknife over satellites counts their power
+    differences). When a signal's chi-square has a p-value under :data:`SIGNAL_PATTERN_P` (GPS L2 P(Y) tracked
+    semi-codelessly falls faster with elevation than L1 C/A), the gain pattern becomes the first signal's own
+    and every other signal gets ``p["cn0_offset_table"][name]``: its level minus the first signal's, per bin,
+    fitted by weighted least squares as a + b (theta / 90 deg)^2 (theta the angle from boresight: a rolloff of
+    its own), tabulated every 10 degrees. Two numbers per signal, not one per bin: a bin's mean is mostly which
+    satellites are in it."""
+    from scipy.stats import chi2
+
+    edges = fidelity.ELEVATION_EDGES_DEG
+    el_deg = np.degrees(el)
+    shared = p["cn0_zenith_dbhz"] + np.array(p["gain_pattern"][1][::2])[::-1]     # level per bin, lowest first
+    bins, significant = {}, False
+    for g in sigs:
+        x = real["obs"]["cn0"][g.name] - _cn0_offset(g, p)
+        bins[g.name] = [b if b["n"] >= 10 and b["mean"] is not None and b["se"] else None
+                        for b in (noise_fit.bin_mean(x, el_deg, lo, hi) for lo, hi in zip(edges[:-1], edges[1:]))]
+        z = [(b["mean"] - lv) / b["se"] for b, lv in zip(bins[g.name], shared) if b is not None]
+        significant |= len(z) > 1 and chi2.sf(float(np.sum(np.square(z))), len(z)) < SIGNAL_PATTERN_P
+    if not significant or len(sigs) < 2:
+        return
+    first = bins[sigs[0].name]
+    p["gain_pattern"] = _pattern([b["mean"] if b is not None else None for b in first], p)
+    theta = 90.0 - 0.5 * (edges[:-1] + edges[1:])          # each bin's centre, from boresight (deg)
+    nodes = np.arange(0.0, 91.0, 10.0)
+    tables = {}
+    for g in sigs[1:]:
+        rows = [(t, a["mean"] - b["mean"], np.hypot(a["se"], b["se"]))
+                for t, a, b in zip(theta, bins[g.name], first) if a is not None and b is not None]
+        if len(rows) < 2:
+            continue
+        t, d, se = (np.array(c) for c in zip(*rows))
+        design = np.column_stack([np.ones(t.size), (t / 90.0) ** 2]) / se[:, None]
+        coef = np.linalg.lstsq(design, d / se, rcond=None)[0]
+        level = p["cn0_offset_db"].get(g.name, 0.0) + coef[0] + coef[1] * (nodes / 90.0) ** 2
+        tables[g.name] = (tuple(float(n) for n in nodes), tuple(float(v) for v in np.clip(level, -30.0, 30.0)))
+    p["cn0_offset_table"] = tables
+
+
+def cn0_offset_entries(p: dict) -> dict:
+    """The scenario's [gnss.cn0_offset_db] of fitted parameters ``p``: a signal's table where it has one, else
+    its offset (dB)."""
+    tables = p.get("cn0_offset_table", {})
+    out = {k: v for k, v in p.get("cn0_offset_db", {}).items() if k not in tables}
+    out.update({k: {"off_boresight_deg": list(v[0]), "offset_db": list(v[1])} for k, v in tables.items()})
+    return out
 
 
 def _cn0_offset(g, p) -> float:
@@ -376,7 +435,7 @@ def code_tables(p: dict, result: dict) -> dict:
         ok = [x for x in ratios if x]
         if not ok:
             continue
-        now = np.broadcast_to(code_scale_at(scales.get(s, 1.0), np.radians(centres)), centres.shape)
+        now = np.broadcast_to(angle_table_at(scales.get(s, 1.0), np.radians(centres)), centres.shape)
         r = np.array([x if x else np.median(ok) for x in ratios])
         scales[s] = (tuple(float(c) for c in centres), tuple(float(f) for f in now / r))
     p["code_error_scale"] = scales
@@ -425,8 +484,9 @@ def toml_fragment(p: dict) -> str:
              "# each signal's multipath correlation time (s)", "[gnss.multipath.signal_correlation_time_s]",
              *(f"{k} = {v:.1f}" for k, v in p.get("mp_signal_correlation_time_s", {}).items()), "",
              "[gnss.code_error_scale]", *(f"{k} = {_scale_toml(v)}" for k, v in p.get("code_error_scale", {}).items()),
-             "", "# the receiver's C/N0 per signal beyond the signal table's offsets",
-             "[gnss.cn0_offset_db]", *(f"{k} = {v:.2f}" for k, v in p.get("cn0_offset_db", {}).items()),
+             "", "# the receiver's C/N0 per signal beyond the signal table's offsets (by the angle from boresight where "
+             "one pattern does not serve every signal)",
+             "[gnss.cn0_offset_db]", *(f"{k} = {_offset_toml(v)}" for k, v in cn0_offset_entries(p).items()),
              "",
              "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]",
              f"rolloff_db = {p['rolloff_db']:.2f}" if not p.get("gain_pattern") else
@@ -472,6 +532,13 @@ def _toml_value(v) -> str:
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(f"{x:.4f}" for x in v) + "]"
     return f"{v:.4f}"
+
+
+def _offset_toml(v) -> str:
+    if isinstance(v, dict):
+        return (f"{{off_boresight_deg = [{', '.join(f'{a:g}' for a in v['off_boresight_deg'])}], "
+                f"offset_db = [{', '.join(f'{o:.2f}' for o in v['offset_db'])}]}}")
+    return f"{v:.2f}"
 
 
 def _scale_toml(v) -> str:
