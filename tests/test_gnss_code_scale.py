@@ -161,6 +161,44 @@ def test_a_malformed_cn0_offset_table_is_one_error_naming_the_key(table, key, wo
     assert f"gnss.cn0_offset_db.{key}" in str(e.value) and words in str(e.value)
 
 
+def test_a_satellites_cn0_offset_moves_that_satellite_and_signal_only(tmp_path):
+    """[gnss.satellite_cn0_offset_db.L2W] G05 = -4: G05's L2W C/N0 4 dB lower at every epoch it is tracked; every
+    other satellite-signal bit for bit the same."""
+    sc = _scenario({})
+    base = run(sc, out=tmp_path / "a.h5")
+    with open_dataset(base) as ds:
+        g0 = read_gnss(ds, antennas=0, obs=("cn0",))
+        sats = [str(x) for x in g0.sat_id]
+    on = np.isfinite(g0.obs["cn0"]["L2W"])
+    sat = sats[int(np.argmax(on.sum(0)))]          # the satellite tracked longest
+    sc["gnss"]["satellite_cn0_offset_db"] = {"L2W": {sat: -4.0}}
+    with open_dataset(run(sc, out=tmp_path / "b.h5")) as ds:
+        g1 = read_gnss(ds, antennas=0, obs=("cn0",))
+    k = sats.index(sat)
+    assert on[:, k].sum() > 100
+    np.testing.assert_allclose(g1.obs["cn0"]["L2W"][:, k][on[:, k]], g0.obs["cn0"]["L2W"][:, k][on[:, k]] - 4.0,
+                               atol=1e-9)
+    others = np.ones(len(sats), bool)
+    others[k] = False
+    assert np.array_equal(g1.obs["cn0"]["L2W"][:, others], g0.obs["cn0"]["L2W"][:, others], equal_nan=True)
+    assert np.array_equal(g1.obs["cn0"]["L1C"], g0.obs["cn0"]["L1C"], equal_nan=True)
+
+
+@pytest.mark.parametrize("table, key, words", [
+    ({"L2W": {"G1": 1.0}}, "L2W.G1", "satellite id"),
+    ({"L2W": {"G05": 40.0}}, "L2W.G05", "[-30.0, 30.0]"),
+    ({"L2W": {"G99": 1.0}}, "L2W.G99", "unknown satellite"),
+    ({"L5Q": {"G05": 1.0}}, "L5Q", "unknown key"),
+])
+def test_a_malformed_satellite_cn0_offset_is_one_error_naming_the_key(table, key, words, tmp_path):
+    sc = _scenario({})
+    sc["gnss"]["satellite_cn0_offset_db"] = table
+    with pytest.raises(ScenarioError) as e:
+        run(sc, out=tmp_path / "x.h5")
+    assert f"gnss.satellite_cn0_offset_db.{key}" in str(e.value) and words in str(e.value)
+    assert not (tmp_path / "x.h5").exists()
+
+
 @pytest.mark.parametrize("table, words", [({"L2W": 45.0}, "[-30.0, 30.0]"), ({"L5Q": 1.0}, "unknown key"),
                                           ({"L1C": "high"}, "L1C")])
 def test_a_malformed_cn0_offset_is_one_error_naming_the_key(table, words):

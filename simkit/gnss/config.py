@@ -90,6 +90,7 @@ class GnssConfig:
     iono_coefficients: dict[str, tuple] = field(default_factory=dict)  # "gps"/"bds" -> (alpha, beta) overrides
     code_error_scale: dict = field(default_factory=dict)  # signal -> factor (or (el_deg, factor) table) on code noise + multipath
     cn0_offset_db: dict = field(default_factory=dict)  # signal -> dB (or (off_boresight_deg, dB) table) added to the table's C/N0 offset
+    satellite_cn0_offset_db: dict = field(default_factory=dict)  # signal -> {satellite id: dB} on top of it
     truth_errors: TruthErrorsConfig | None = None  # departures of the truth from the receiver's models; None: off
     acquisition: AcquisitionConfig = field(default_factory=AcquisitionConfig)  # rising satellites' first track
     shadowing: ShadowingConfig | None = None  # stochastic street shadowing / blockage of C/N0; None: off
@@ -140,6 +141,7 @@ def parse_config(sec: Section) -> GnssConfig:
         iono_coefficients=_ionosphere(sec.section("ionosphere")),
         code_error_scale=_code_scale(sec.section("code_error_scale"), sigs),
         cn0_offset_db=_cn0_offset(sec.section("cn0_offset_db"), sigs),
+        satellite_cn0_offset_db=_satellite_cn0_offset(sec.section("satellite_cn0_offset_db"), sigs),
         truth_errors=parse_truth_errors(sec.section("truth_errors")),
         acquisition=parse_acquisition(sec.section("acquisition")),
         shadowing=parse_shadowing(sec.section("shadowing")),
@@ -282,6 +284,27 @@ def _cn0_offset(cs: Section, sigs: list[str]) -> dict:
     return out
 
 
+def _satellite_cn0_offset(cs: Section, sigs: list[str]) -> dict:
+    """[gnss.satellite_cn0_offset_db.<signal>]: satellite id ("G01") -> dB (in [-30, 30]) added to that
+    satellite's C/N0 of that signal: satellites transmit different powers (GPS blocks IIR, IIR-M, IIF and III
+    differ by a few dB, on L2 most), and a static antenna sees each satellite along its own track
+    (``simkit twin --fit`` estimates them at a fixed station)."""
+    out = {}
+    for name in sigs:
+        if not cs.has(name):
+            continue
+        t = cs.section(name)
+        table = {}
+        for sat in list(t.data):
+            if not (isinstance(sat, str) and len(sat) == 3 and sat[0] in "GCEJR" and sat[1:].isdigit()):
+                raise t.error(str(sat), "expected a satellite id: a system letter and two digits (e.g. G01)")
+            table[sat] = t.get(sat, float, check=in_range(-30.0, 30.0))
+        t.done()
+        out[name] = table
+    cs.done()
+    return out
+
+
 def _code_scale_table(t: Section) -> tuple:
     return _angle_table(t, "elevation_deg", (-90.0, 90.0), "factor", non_negative)
 
@@ -335,3 +358,8 @@ def check_sats(cfg: GnssConfig, sat_ids) -> None:
         for s in o.sats or ():
             if s not in known:
                 raise ScenarioError(f"gnss.outage[{i}].sats", f"unknown satellite {s!r}")
+    for name, table in cfg.satellite_cn0_offset_db.items():
+        for s in table:
+            if s not in known:
+                raise ScenarioError(f"gnss.satellite_cn0_offset_db.{name}.{s}",
+                                    "unknown satellite: not in the scenario's constellations")

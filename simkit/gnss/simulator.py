@@ -134,6 +134,12 @@ class GnssSimulator:
         self.acquisition = Acquisition(cfg.acquisition, self.n_ant, len(self.sat_ids))
         self.nlos = np.zeros((self.n_ant, len(self.sat_ids)), dtype=bool)   # tracking a reflection only
         self.sat_index = {sid: k for k, sid in enumerate(self.sat_ids)}
+        self.sat_cn0 = None      # (S, G) dB per satellite and signal, [gnss.satellite_cn0_offset_db]
+        if cfg.satellite_cn0_offset_db:
+            self.sat_cn0 = np.zeros((len(self.sat_ids), len(self.signals)))
+            for j, name in enumerate(cfg.signals):
+                for sid, db in cfg.satellite_cn0_offset_db.get(name, {}).items():
+                    self.sat_cn0[self.sat_index[sid], j] = db
         self.shadowing = None if cfg.shadowing is None else Shadowing(cfg.shadowing, seed, self.sat_ids,
                                                                        self.n_ant, self.dt)
         self._truth_models(seed)
@@ -516,6 +522,8 @@ class _Parts:
             if ant.gain_pattern is not None:
                 cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern,
                                                    cn0_off[:, a] if np.ndim(cn0_off) else cn0_off)
+        if sim.sat_cn0 is not None:
+            cn0 = cn0 + sim.sat_cn0[cols, j]
         if self.shadow is not None:
             cn0 = cn0 - self.shadow.attenuation_db[..., cj]
         freq = sim.freq[cols, j]                                                    # (C,) Hz

@@ -104,6 +104,8 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                  "noise": {"dll_bandwidth_hz": p["dll_bandwidth_hz"], "pll_bandwidth_hz": p["pll_bandwidth_hz"],
                            "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
                  "cn0_offset_db": cn0_offset_entries(p),
+                 **({"satellite_cn0_offset_db": {k: dict(v) for k, v in p["satellite_cn0_offset_db"].items()}}
+                    if p.get("satellite_cn0_offset_db") else {}),
                  "code_error_scale": {k: {"elevation_deg": list(v[0]), "factor": list(v[1])}
                                       if isinstance(v, (tuple, list)) else v
                                       for k, v in p.get("code_error_scale", {}).items()},
@@ -279,16 +281,36 @@ def fit_parameters(real: dict, reference) -> dict:
 
 
 def _fit_cn0(real, sigs, el, p) -> bool:
-    """Set ``p``'s zenith C/N0, rolloff, per-signal C/N0 offsets and gain pattern from the real C/N0 (least
-    squares of the quadratic model with one offset per signal beyond the first, relative to the signal table's,
-    then :func:`_gain_pattern`), and the step of its reported values ([gnss.cn0_report]); False when the file
-    has no signal strength."""
+    """Set ``p``'s C/N0 model from the real C/N0 (:func:`_fit_cn0_levels`) and the step of its reported values
+    ([gnss.cn0_report]); at a fixed antenna also each satellite's own offset (:func:`_satellite_offsets`), the
+    levels fitted again on the C/N0 less those offsets (three rounds: a bin's mean is partly which satellites
+    are in it). False when the file has no signal strength."""
     step = noise_fit.cn0_resolution(real["obs"]["cn0"].values())
     if step > 0:   # the receiver writes its C/N0 in steps: the twin's is rounded the same way
         p["cn0_report"] = {"resolution_dbhz": step}
+    cn0 = real["obs"]["cn0"]
+    static = not real.get("trajectory")    # at a street the levels are the street's (the shadowing fit's)
+    if not _fit_cn0_levels(cn0, sigs, el, p, static):
+        return False
+    if static:
+        for _ in range(3):
+            offsets = _satellite_offsets(cn0, sigs, el, p, real["sat_id"])
+            if not offsets:
+                break
+            rows = {s: np.array([v.get(k, 0.0) for k in real["sat_id"]]) for s, v in offsets.items()}
+            _fit_cn0_levels({s: c - rows.get(s, 0.0) for s, c in cn0.items()}, sigs, el, p, static)
+        if offsets:
+            p["satellite_cn0_offset_db"] = offsets
+    return True
+
+
+def _fit_cn0_levels(cn0: dict, sigs, el, p, static: bool) -> bool:
+    """Zenith C/N0, rolloff and per-signal offsets (least squares of the quadratic model with one offset per
+    signal beyond the first, relative to the signal table's), then the gain pattern (:func:`_gain_pattern`) and,
+    at a fixed antenna, the per-signal tables (:func:`_signal_patterns`), from C/N0 ``cn0`` (signal -> (M, S))."""
     rows_x, rows_y, names = [], [], []
     for g in sigs:
-        c = real["obs"]["cn0"][g.name]
+        c = cn0[g.name]
         ok = np.isfinite(c) & np.isfinite(el)
         if ok.any():
             x = ((np.pi / 2 - el[ok]) / (np.pi / 2)) ** 2
@@ -308,10 +330,52 @@ def _fit_cn0(real, sigs, el, p) -> bool:
     p["cn0_zenith_dbhz"] = float(np.clip(sol[0], 10.0, 70.0))
     p["rolloff_db"] = float(max(sol[1], 0.0))
     p["cn0_offset_db"] = {n: float(np.clip(v, -30.0, 30.0)) for n, v in zip(names[1:], sol[2:])}
-    p["gain_pattern"] = _gain_pattern(real, sigs, el, p)
-    if not real.get("trajectory"):     # at a street the bins' levels are the street's (the shadowing fit's)
-        _signal_patterns(real, [g for g in sigs if g.name in names], el, p)
+    p.pop("cn0_offset_table", None)
+    p["gain_pattern"] = _gain_pattern(cn0, sigs, el, p)
+    if static:
+        _signal_patterns(cn0, [g for g in sigs if g.name in names], el, p)
     return True
+
+
+def _model_cn0(g, el, p):
+    """The fitted C/N0 (dB-Hz) of signal ``g`` at elevations ``el`` (rad) of a level antenna: zenith, the
+    signal's offset (its table where it has one), the gain pattern."""
+    theta = np.pi / 2 - el
+    offset = angle_table_at(p.get("cn0_offset_table", {}).get(g.name, p["cn0_offset_db"].get(g.name, 0.0)), theta)
+    return (p["cn0_zenith_dbhz"] + g.cn0_offset_db + offset
+            + np.interp(np.degrees(theta), p["gain_pattern"][0], p["gain_pattern"][1]))
+
+
+# satellites' C/N0 differ beyond their sampling when the chi-square of their mean residuals has a p-value under this
+SATELLITE_OFFSET_P = 1e-3
+
+
+def _satellite_offsets(cn0: dict, sigs, el, p, sat_ids) -> dict:
+    """Per signal, each satellite's mean C/N0 residual to the model (:func:`_model_cn0`), less their mean
+    weighted by epochs (the model keeps the level): {signal: {satellite: dB}}, for the signals whose satellites
+    differ beyond sampling (the chi-square of the means in their standard errors, n_eff from each series'
+    lag-one autocorrelation, has a p-value under :data:`SATELLITE_OFFSET_P`). A satellite with fewer than 10
+    values gets none."""
+    from scipy.stats import chi2
+
+    out = {}
+    for g in sigs:
+        r = cn0[g.name] - _model_cn0(g, el, p)
+        n = np.isfinite(r).sum(axis=0)
+        keep = np.flatnonzero(n >= 10)
+        if keep.size < 2:
+            continue
+        means = np.array([np.nanmean(r[:, k]) for k in keep])
+        ses = []
+        for k, m in zip(keep, means):
+            v = r[:, k][np.isfinite(r[:, k])]
+            ne = noise_fit.n_effective(v.size, noise_fit.lag_one(r[:, k] - m))
+            ses.append(max(float(np.std(v)), 0.05) / np.sqrt(ne))
+        centred = means - np.average(means, weights=n[keep])
+        stat = float(np.sum((centred / np.array(ses)) ** 2))
+        if chi2.sf(stat, keep.size - 1) < SATELLITE_OFFSET_P:
+            out[g.name] = {sat_ids[k]: float(np.clip(v, -30.0, 30.0)) for k, v in zip(keep, centred)}
+    return out
 
 
 # a signal's C/N0 levels per bin differ from the shared pattern beyond sampling when the chi-square of the
@@ -319,7 +383,7 @@ def _fit_cn0(real, sigs, el, p) -> bool:
 SIGNAL_PATTERN_P = 1e-3
 
 
-def _signal_patterns(real, sigs, el, p) -> None:
+def _signal_patterns(cn0: dict, sigs, el, p) -> None:
     """Per-signal C/N0 offset tables of a fixed antenna, where one gain pattern does not serve every signal.
 
     Each signal's mean C/N0 (less its offset) per 10-degree bin is compared with the shared pattern's level there,
@@ -337,7 +401,7 @@ def _signal_patterns(real, sigs, el, p) -> None:
     shared = p["cn0_zenith_dbhz"] + np.array(p["gain_pattern"][1][::2])[::-1]     # level per bin, lowest first
     bins, significant = {}, False
     for g in sigs:
-        x = real["obs"]["cn0"][g.name] - _cn0_offset(g, p)
+        x = cn0[g.name] - _cn0_offset(g, p)
         bins[g.name] = [b if b["n"] >= 10 and b["mean"] is not None and b["se"] else None
                         for b in (noise_fit.bin_mean(x, el_deg, lo, hi) for lo, hi in zip(edges[:-1], edges[1:]))]
         z = [(b["mean"] - lv) / b["se"] for b, lv in zip(bins[g.name], shared) if b is not None]
@@ -376,13 +440,13 @@ def _cn0_offset(g, p) -> float:
     return g.cn0_offset_db + p.get("cn0_offset_db", {}).get(g.name, 0.0)
 
 
-def _gain_pattern(real, sigs, el, p) -> tuple:
+def _gain_pattern(cn0: dict, sigs, el, p) -> tuple:
     """The antenna gain pattern (off-boresight deg, gain dB) of a level antenna (off-boresight = 90 deg -
     elevation), a step per elevation bin (two points just inside its edges): the mean of C/N0 minus each
     signal's offset over the bin, minus the fitted zenith C/N0; a bin without ``fidelity.by_elevation``'s
     minimum count takes the quadratic rolloff at its centre. Steps, not a line through the bins' centres: the
     satellites of a short file sit anywhere in their bin, and the comparison is per bin."""
-    pooled = np.concatenate([real["obs"]["cn0"][g.name] - _cn0_offset(g, p) for g in sigs], axis=1)
+    pooled = np.concatenate([cn0[g.name] - _cn0_offset(g, p) for g in sigs], axis=1)
     return _pattern(fidelity.by_elevation(pooled, np.tile(el, (1, len(sigs)))), p)
 
 
@@ -487,6 +551,7 @@ def toml_fragment(p: dict) -> str:
              "", "# the receiver's C/N0 per signal beyond the signal table's offsets (by the angle from boresight where "
              "one pattern does not serve every signal)",
              "[gnss.cn0_offset_db]", *(f"{k} = {_offset_toml(v)}" for k, v in cn0_offset_entries(p).items()),
+             *_satellite_offsets_toml(p.get("satellite_cn0_offset_db", {})),
              "",
              "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]",
              f"rolloff_db = {p['rolloff_db']:.2f}" if not p.get("gain_pattern") else
@@ -532,6 +597,14 @@ def _toml_value(v) -> str:
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(f"{x:.4f}" for x in v) + "]"
     return f"{v:.4f}"
+
+
+def _satellite_offsets_toml(tables: dict) -> list:
+    lines = ["", "# each satellite's C/N0 beyond the model, per signal (its power; at a station, its track)"] \
+        if tables else []
+    for name, table in tables.items():
+        lines += [f"[gnss.satellite_cn0_offset_db.{name}]", *(f"{k} = {v:.2f}" for k, v in table.items())]
+    return lines
 
 
 def _offset_toml(v) -> str:
