@@ -243,6 +243,28 @@ def test_ionosphere_residual_has_the_configured_relative_rms():
         np.full_like(sow[:5], WEEK), sow[:5], sow[:5])[0], iono[:5], rtol=0, atol=0)
 
 
+def test_ionosphere_scale_multiplies_klobuchar_with_and_without_the_residual():
+    """iono_scale k: without a residual the truth is exactly k x Klobuchar (its rate too); with one, the same
+    field's factor times k (the residual's draws unchanged)."""
+    rs = np.random.default_rng(1)
+    n = 500
+    lla = np.stack([rs.uniform(-1.2, 1.2, n), rs.uniform(-3.1, 3.1, n), np.zeros(n)], axis=-1)[:, None]
+    az, el = rs.uniform(0, 2 * np.pi, (n, 1, 1)), rs.uniform(0.2, 1.5, (n, 1, 1))
+    azr, elr = rs.normal(0, 1e-4, (n, 1, 1)), rs.normal(0, 1e-4, (n, 1, 1))
+    sow = rs.uniform(0.0, 10 * 86400.0, (n, 1, 1))
+    alpha, beta = (2.2352e-08, 1.4901e-08, -1.1921e-07, -5.9605e-08), (1.2493e05, 6.5536e04, -1.9661e05, 6.5536e04)
+    args = ("G", alpha, beta, lla, np.zeros_like(lla), az, el, azr, elr, np.full_like(sow, WEEK), sow, sow)
+    assert not TruthIonosphere(5, 0.0, 1000e3, 3600.0).departs and TruthIonosphere(5, 0.0, 1000e3, 3600.0,
+                                                                                    scale=0.2).departs
+    iono, rate, klob = TruthIonosphere(5, 0.0, 1000e3, 3600.0, scale=0.2).delay(*args)
+    _, k_rate, _ = TruthIonosphere(5, 0.0, 1000e3, 3600.0, scale=1.0).delay(*args)
+    np.testing.assert_allclose(iono, 0.2 * klob, rtol=1e-15)
+    np.testing.assert_allclose(rate, 0.2 * k_rate, rtol=0, atol=1e-13)     # differences of products: rounding
+    base = TruthIonosphere(5, 0.5, 1000e3, 3600.0).delay(*args)[0]
+    np.testing.assert_allclose(TruthIonosphere(5, 0.5, 1000e3, 3600.0, scale=0.2).delay(*args)[0], 0.2 * base,
+                               rtol=1e-14)
+
+
 def test_zenith_wet_random_walk_grows_as_configured_and_mapping_differs_at_low_elevation():
     sig = 0.01
     ends = np.array([TruthTroposphere(seed, WEEK, 86400.0, 4 * 3600.0, "niell", 0.0, 0.0, sig).walk(np.array(
@@ -284,6 +306,8 @@ def test_ionex_map_is_the_truth_ionosphere_when_given():
     ({"tropo_mapping": "gmf"}, "gnss.truth_errors.tropo_mapping", "must be one of"),
     ({"bds_ephemeris_interval_s": 0.0}, "gnss.truth_errors.bds_ephemeris_interval_s", "must be in"),
     ({"ionex_file": " "}, "gnss.truth_errors.ionex_file", "expected a file path"),
+    ({"iono_scale": -0.1}, "gnss.truth_errors.iono_scale", "must be in"),
+    ({"model": "none", "iono_scale": 0.5}, "gnss.truth_errors.iono_scale", 'model = "none"'),
 ])
 def test_truth_error_keys_are_validated_with_the_key_named(table, key, words):
     gnss = {"constellation": [{"source": "nominal:gps"}], "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0]}],

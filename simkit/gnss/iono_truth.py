@@ -3,7 +3,8 @@
 The receiver corrects its code with the broadcast Klobuchar model, which removes roughly half of the ionospheric
 delay (RMS). The truth therefore departs from it:
 
-* without a map: I_true = I_Klobuchar exp(s e(x, t) - s^2/2), where e is a zero-mean, unit-variance Gaussian-like
+* without a map: I_true = k I_Klobuchar exp(s e(x, t) - s^2/2), k the mean ratio (``iono_scale``, 1 by default:
+  at night or at solar minimum the real ionosphere can sit well below the model's floor), where e is a zero-mean, unit-variance Gaussian-like
   random field of the ionospheric pierce point x (on a 350 km shell, Earth-fixed, km) and time t, with covariance
   exp(-|dx|^2 / (2 L^2) - dt^2 / (2 tau^2)), built as a sum of 64 random Fourier features (Rahimi and Recht 2007);
   s = sqrt(ln(1 + f^2)) so that RMS(I_true / I_Klobuchar - 1) = f (``iono_residual_fraction``). The factor is
@@ -76,17 +77,20 @@ class ResidualField:
 
 
 class TruthIonosphere:
-    """Truth ionospheric delay at a system's reference frequency (L1 for GPS, B1I for BDS): ``fraction`` the RMS
-    relative departure from Klobuchar (0: the truth is Klobuchar), or ``ionex`` maps (which then replace it)."""
+    """Truth ionospheric delay at a system's reference frequency (L1 for GPS, B1I for BDS): ``scale`` times
+    Klobuchar with ``fraction`` the RMS relative departure about it (scale 1, fraction 0: the truth is Klobuchar),
+    or ``ionex`` maps (which then replace both)."""
 
-    def __init__(self, seed: int, fraction: float, length_m: float, time_s: float, ionex: IonexMaps | None = None):
+    def __init__(self, seed: int, fraction: float, length_m: float, time_s: float, ionex: IonexMaps | None = None,
+                 scale: float = 1.0):
         self.ionex = ionex
+        self.scale = float(scale)
         self.sigma = float(np.sqrt(np.log1p(fraction**2)))
         self.field = ResidualField(seed, length_m, time_s) if self.sigma > 0 and ionex is None else None
 
     @property
     def departs(self) -> bool:
-        return self.field is not None or self.ionex is not None
+        return self.field is not None or self.ionex is not None or self.scale != 1.0
 
     def delay(self, system, alpha, beta, lla, vel_enu, az, el, az_rate, el_rate, week, sow, t, h: float = 0.05):
         """(truth, truth rate, Klobuchar) in m and m/s for receivers at ``lla`` (M, A, 3) moving at ``vel_enu``
@@ -109,7 +113,7 @@ class TruthIonosphere:
                 lat_p, lon_p = pierce_point(la, lo, a, e, m.base_radius_m, m.height_m)
                 tec = m.vtec(week, sow + s, lat_p, lon_p) * slant_factor(e, m.base_radius_m, m.height_m)
                 points.append(IONO_CONSTANT * TECU * tec / reference_frequency(system) ** 2)
-        truth = points if self.ionex is not None else klob
+        truth = points if self.ionex is not None else [self.scale * k for k in klob]
         return truth[1], (truth[2] - truth[0]) / (2.0 * h), klob[1]
 
     def _field_delay(self, system, alpha, beta, lat, lon, lat_rate, lon_rate, az, el, az_rate, el_rate, sow, t,
@@ -126,5 +130,5 @@ class TruthIonosphere:
                                                    az_rate, el_rate, epoch_sow, np.array(steps), SHELL_RADIUS_M,
                                                    SHELL_HEIGHT_M)
         e = self.field.clusters(points, epoch_t, np.array(steps))                          # (M, A, 3, C)
-        truth = klob * np.exp(self.sigma * e - 0.5 * self.sigma**2)
+        truth = klob * (self.scale * np.exp(self.sigma * e - 0.5 * self.sigma**2))
         return truth[:, :, 1], (truth[:, :, 2] - truth[:, :, 0]) / (2.0 * steps[2]), klob[:, :, 1]

@@ -168,7 +168,7 @@ class GnssSimulator:
                 raise ScenarioError("gnss.truth_errors.ionex_file", f"{te.ionex_file}: its TEC maps ({span}) do not "
                                     "cover the run (scenario.start, scenario.duration_s)")
         iono = TruthIonosphere(seed, te.iono_residual_fraction, te.iono_correlation_length_km * 1e3,
-                               te.iono_correlation_time_s, ionex)
+                               te.iono_correlation_time_s, ionex, te.iono_scale)
         self.truth_iono = iono if iono.departs else None
         tropo = TruthTroposphere(seed, self.start_week, self.start_sow, self.duration_s, te.tropo_mapping,
                                  te.tropo_zhd_sigma_m, te.tropo_zwd_sigma_m, te.tropo_zwd_random_walk_m_per_sqrt_h)

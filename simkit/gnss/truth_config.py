@@ -32,7 +32,8 @@ class EphemerisErrorConfig:
 @dataclass(frozen=True)
 class TruthErrorsConfig:
     model: str                                   # "realistic" or "none"
-    iono_residual_fraction: float                # RMS of (true - Klobuchar) / Klobuchar
+    iono_residual_fraction: float                # RMS of (true - k Klobuchar) / (k Klobuchar)
+    iono_scale: float                            # k: the truth's mean ratio to Klobuchar
     iono_correlation_length_km: float            # of the residual field at the pierce points
     iono_correlation_time_s: float
     ionex_file: str | None                       # a global ionosphere map: the truth ionosphere when given
@@ -48,7 +49,7 @@ class TruthErrorsConfig:
 
 
 _REALISTIC = {
-    "iono_residual_fraction": 0.5, "iono_correlation_length_km": 1000.0, "iono_correlation_time_s": 3600.0,
+    "iono_residual_fraction": 0.5, "iono_scale": 1.0, "iono_correlation_length_km": 1000.0, "iono_correlation_time_s": 3600.0,
     "tropo_mapping": "niell", "tropo_zhd_sigma_m": 0.02, "tropo_zwd_sigma_m": 0.04,
     "tropo_zwd_random_walk_m_per_sqrt_h": 0.01,
     "gps_orbit_sigma_rac_m": [0.15, 0.6, 0.4], "gps_clock_sigma_m": 0.5, "gps_ephemeris_interval_s": 7200.0,
@@ -91,6 +92,7 @@ def parse_truth_errors(sec: Section) -> TruthErrorsConfig:
         model=model,
         iono_residual_fraction=sec.get("iono_residual_fraction", float, d["iono_residual_fraction"],
                                        check=in_range(0.0, 5.0)),
+        iono_scale=sec.get("iono_scale", float, d["iono_scale"], check=in_range(0.0, 5.0)),
         iono_correlation_length_km=sec.get("iono_correlation_length_km", float, d["iono_correlation_length_km"],
                                            check=positive),
         iono_correlation_time_s=sec.get("iono_correlation_time_s", float, d["iono_correlation_time_s"],
