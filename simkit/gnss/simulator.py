@@ -509,21 +509,29 @@ class _Parts:
         self.orb_rate = (orb[1] - orb[2]) / (2.0 * h)
         self.range, self.range_rate = view.range + self.orb, view.range_rate + self.orb_rate
 
+    def _cn0(self, j, g, off, cols):
+        """True C/N0 (dB-Hz) of signal ``g`` (index ``j``) at the off-boresight angles ``off`` (M, A, C) rad of the
+        satellite columns ``cols``: zenith, the antenna's rolloff or gain pattern, the signal's offset (a table by
+        the angle where given), each satellite's own offset; street shadowing comes after."""
+        cfg = self.sim.cfg
+        rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
+        cn0_off = g.cn0_offset_db + angle_table_at(cfg.cn0_offset_db.get(g.name, 0.0), off)
+        cn0 = noise.cn0_dbhz(off, cfg.cn0_zenith_dbhz, rolloff, cn0_off)
+        for a, ant in enumerate(cfg.antennas):
+            if ant.gain_pattern is not None:
+                cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a], cfg.cn0_zenith_dbhz, ant.gain_pattern,
+                                                   cn0_off[:, a] if np.ndim(cn0_off) else cn0_off)
+        if self.sim.sat_cn0 is not None:
+            cn0 = cn0 + self.sim.sat_cn0[cols, j]
+        return cn0
+
     def _signal(self, j, g, off, draws, tracked, amb, lli):
         """Observables and error terms of signal ``g`` (index ``j``) on the columns that transmit it."""
         sim, cfg, err = self.sim, self.sim.cfg, self.sim.cfg.errors
         cj = np.flatnonzero(sim.carries[self.cand, j])
         cols = self.cand[cj]
         cj = consecutive(cj)   # one system's columns: views, not copies
-        rolloff = np.array([x.rolloff_db for x in cfg.antennas])[None, :, None]
-        cn0_off = g.cn0_offset_db + angle_table_at(cfg.cn0_offset_db.get(g.name, 0.0), off[..., cj])
-        cn0 = noise.cn0_dbhz(off[..., cj], cfg.cn0_zenith_dbhz, rolloff, cn0_off)
-        for a, ant in enumerate(cfg.antennas):
-            if ant.gain_pattern is not None:
-                cn0[:, a] = noise.pattern_cn0_dbhz(off[:, a][:, cj], cfg.cn0_zenith_dbhz, ant.gain_pattern,
-                                                   cn0_off[:, a] if np.ndim(cn0_off) else cn0_off)
-        if sim.sat_cn0 is not None:
-            cn0 = cn0 + sim.sat_cn0[cols, j]
+        cn0 = self._cn0(j, g, off[..., cj], cols)
         if self.shadow is not None:
             cn0 = cn0 - self.shadow.attenuation_db[..., cj]
         freq = sim.freq[cols, j]                                                    # (C,) Hz
