@@ -13,9 +13,17 @@ KMS3_OBS = OBS / "KMS300DNK_R_20221591000_01H_30S_MO.crx"
 KMS3_NAV = NAV / "KMS300DNK_R_20221591000_01H_MN.rnx.gz"
 BERLIN_OBS = OBS / "Berlin_Potsdamer_Platz_60ep.obs"
 BERLIN_NAV = NAV / "BRDC00WRD_U_20161580000_01D_MN.rnx.gz"
-CN00_OBS = OBS / "cn000010.21o"            # 3 h 40 min of a static CORS station with C/N0 (tests/data/SOURCES.md)
-CN00_NAV = ROOT / "tests" / "data" / "rinex_nav" / "brdc0010.21n"   # RINEX 2.11 GPS, its day's first hours
+CN00_OBS = OBS / "cn000010.21o"            # 24 h of a static CORS station with C/N0 (tests/data/SOURCES.md)
+CN00_NAV = ROOT / "tests" / "data" / "rinex_nav" / "brdc0010.21n"   # its day's RINEX 2.11 GPS broadcast file
 KMS3_HEADER_POS = np.array([3516213.4380, 781859.8595, 5246037.9660])  # APPROX POSITION XYZ, delta H/E/N zero
+
+
+def cn00_first_epochs(dst, n: int) -> Path:
+    """The header and the first ``n`` epoch records of CN00's file, byte for byte (a shorter file for a test)."""
+    lines = CN00_OBS.read_bytes().split(b"\r\n")
+    starts = [i for i, ln in enumerate(lines) if ln.startswith(b" 21  1  1 ")]
+    Path(dst).write_bytes(b"\r\n".join(lines[:starts[n]]) + b"\r\n")
+    return Path(dst)
 
 
 def rinex4_nav_as_rinex3(src, dst) -> Path:

@@ -237,28 +237,26 @@ def test_twin_of_kms3_with_fit(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_calibrated_twin_of_a_static_station_with_cn0(tmp_path):
-    """CN00 (Trimble NetR9, 3 h 40 min at 30 s, GPS L1C + L2W with C/N0) against its calibrated twin, the
-    targets of the real-data comparison where this file resolves them: visibility agreement >= 98 % in sample;
-    every equal-count code-noise bin within 20 % in sample and on the interleaved split, all but one
-    on the half split, most bins resolving 20 % (standard error <= 10 %); L1C's C/N0 bin means within 1.5 dB-Hz
-    RMS in and out of sample. L2W's (semi-codeless P(Y)) standard errors are 3-4 dB from its satellites' spread:
-    there the check is the chi-square (about 1 or less when the bins differ by sampling)."""
+    """CN00 (Trimble NetR9, 24 h at 30 s, GPS L1C + L2W with C/N0, its own broadcast file) against its calibrated
+    twin: the targets of the real-data comparison, in sample and on both out-of-sample splits (fitted on half the
+    day, checked on the other half; fitted on alternate blocks, checked on the others): visibility agreement >= 98 %;
+    every equal-count code-noise bin within 20 % and resolving 20 % (standard error <= 10 %); the C/N0 bin means
+    of both signals within 1.5 dB-Hz RMS. L2W falls faster with elevation than L1C: its own offset table."""
     out = tmp_path / "twin"
     assert main(["twin", str(CN00_OBS), "--nav", str(CN00_NAV), "-o", str(out), "--fit", "--no-plots"]) == 0
     fid = json.loads((out / "fidelity.json").read_text())
-    assert fid["fitted"]["visibility_agreement"] >= 0.98
     fragment = tomllib.loads((out / "fitted.toml").read_text())["gnss"]
-    assert isinstance(fragment["cn0_offset_db"]["L2W"], dict)            # L2W falls faster than L1C's pattern
+    assert isinstance(fragment["cn0_offset_db"]["L2W"], dict)
     assert set(fragment["satellite_cn0_offset_db"]) == {"L1C", "L2W"}
-    for key, noise, least in (("in", fid["noise"]["in_sample"], 12), ("half", fid["holdout"]["noise"], 11),
-                              ("interleaved", fid["holdout_interleaved"]["noise"], 12)):
-        if key != "in":   # the horizon of a split's fitting epochs: 94.6 % (half) and 90.6 % (interleaved), the
-            # receiver acquiring rising satellites late where setting ones were tracked low (docs/real_data.md)
-            assert fid["holdout" if key == "half" else "holdout_interleaved"]["visibility_agreement"] >= 0.88
+    assert fid["fitted"]["visibility_agreement"] >= 0.98
+    for key, noise in (("in", fid["noise"]["in_sample"]), ("holdout", fid["holdout"]["noise"]),
+                       ("holdout_interleaved", fid["holdout_interleaved"]["noise"])):
+        if key != "in":
+            assert fid[key]["visibility_agreement"] >= 0.98, key
         sm = noise["code_noise"]["summary"]
-        assert sm["bins"] == 12 and sm["within"] >= least and sm["resolved"] >= 9, (key, sm)
-        assert noise["cn0"]["L1C"]["rms_dbhz"] <= 1.5, key
-        assert noise["cn0"]["L2W"]["chi2_per_bin"] < 1.0 and noise["cn0"]["L2W"]["spread_rms_db"] < 2.5, key
+        assert sm["bins"] == 12 and sm["within"] == 12 and sm["resolved"] == 12, (key, sm)
+        for signal in ("L1C", "L2W"):
+            assert noise["cn0"][signal]["rms_dbhz"] <= 1.5, (key, signal)
 
 
 def test_the_twin_shows_its_progress(tmp_path, capsys):
