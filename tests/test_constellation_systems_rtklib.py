@@ -6,7 +6,6 @@ within its validity by simkit and by RTKLIB's ``eph2pos`` / ``geph2pos``. Kepler
 GLONASS: both integrate the same equations with 60 s Runge-Kutta steps, so the bound of the issue (< 1 m) is
 loose; the measured figure is printed (run with -s) and held to 1 mm.
 """
-import gzip
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +15,7 @@ import pyrtklib
 from conftest import DATA as _DATA
 from rtklib_nav import gpst, kepler_against_rtklib, rtklib_nav, sat_id
 from simkit.constellation import glonass, kepler, load
+from simkit.constellation.textfile import lines_of, read_bytes
 
 DATA = _DATA / "rinex_nav"
 FILES = ["BRDM00DLR_S_20261170000_01D_MN.rnx.gz", "KMS300DNK_R_20221591000_01H_MN.rnx.gz"]
@@ -116,7 +116,7 @@ def test_broadcast_time_offsets_are_read_as_rtklib_reads_them(tmp_path):
 def _as_rinex2_glonass(src, dst):
     """The GLONASS records of a RINEX 3 file written as a RINEX 2.11 GLONASS navigation file ('G'): 'PP YY MM DD HH
     MM SS.S' + the three clock values, then 3 blanks and the four values of each orbit line (RINEX 2.11, table A10)."""
-    lines = _plain_lines(src)
+    lines = lines_of(read_bytes(src))
     start = next(i for i, ln in enumerate(lines) if "END OF HEADER" in ln) + 1
     out = ["     2.11           G: GLONASS NAV DATA                     RINEX VERSION / TYPE",
            " " * 60 + "END OF HEADER"]
@@ -128,11 +128,6 @@ def _as_rinex2_glonass(src, dst):
             out += ["   " + lines[i + k][4:80] for k in (1, 2, 3)]
     Path(dst).write_text("\n".join(out) + "\n")
     return Path(dst)
-
-
-def _plain_lines(src):
-    raw = Path(src).read_bytes()
-    return (gzip.decompress(raw) if raw[:2] == b"\x1f\x8b" else raw).decode("latin-1").splitlines()
 
 
 def test_rinex2_glonass_file_reads_as_its_rinex3_records_and_as_rtklib_reads_it(tmp_path):

@@ -99,7 +99,8 @@ def _values(block: list[str], path, first_line: int) -> np.ndarray:
 def _header(lines, path):
     """-> (index of the first data line, version, klobuchar dict)."""
     if not is_rinex_nav(lines):
-        raise DataFileError(path, "not a RINEX navigation file (no 'RINEX VERSION / TYPE' with type N)", 1)
+        raise DataFileError(path, "not a RINEX navigation file (no 'RINEX VERSION / TYPE' with type N, or G for RINEX 2 "
+                            "GLONASS)", 1)
     version = number(lines[0][:9], path, 1, "RINEX version", blank=None)
     if not 2.0 <= version < 5.0:
         raise DataFileError(path, f"RINEX navigation version {version} is not supported (2.1x, 3.0x or 4.0x)", 1)

@@ -252,16 +252,7 @@ def _code_scale(cs: Section, sigs: list[str]) -> dict:
     receiver's code tracking: correlator spacing, multipath mitigation; ``simkit twin --fit`` estimates them):
     a number, or a table ``{elevation_deg = [...], factor = [...]}`` (increasing elevations in [-90, 90],
     linear in between, the end values beyond), kept as the pair of tuples (elevation_deg, factor)."""
-    out = {}
-    for name in sigs:
-        if isinstance(cs.data.get(name), dict):
-            out[name] = _code_scale_table(cs.section(name))
-            continue
-        value = cs.get(name, float, None, check=non_negative)
-        if value is not None:
-            out[name] = value
-    cs.done()
-    return out
+    return _per_signal(cs, sigs, "elevation_deg", (-90.0, 90.0), "factor", non_negative)
 
 
 def _cn0_offset(cs: Section, sigs: list[str]) -> dict:
@@ -271,13 +262,18 @@ def _cn0_offset(cs: Section, sigs: list[str]) -> dict:
     [...], offset_db = [...]}`` (increasing angles in [0, 180], linear in between, the end values beyond), kept as
     the pair of tuples: a signal whose C/N0 falls with the angle faster than the antenna pattern says (the
     semi-codeless tracking of GPS L2 P(Y) loses more at low C/N0, and an antenna's gain differs by frequency)."""
+    return _per_signal(cs, sigs, "off_boresight_deg", (0.0, 180.0), "offset_db", in_range(-30.0, 30.0))
+
+
+def _per_signal(cs: Section, sigs: list[str], angle_key: str, bounds: tuple, value_key: str, check) -> dict:
+    """A table keyed by signal name: each entry a number passing ``check``, or an angle table
+    (:func:`_angle_table`); signals not given are left out."""
     out = {}
     for name in sigs:
         if isinstance(cs.data.get(name), dict):
-            out[name] = _angle_table(cs.section(name), "off_boresight_deg", (0.0, 180.0), "offset_db",
-                                     in_range(-30.0, 30.0))
+            out[name] = _angle_table(cs.section(name), angle_key, bounds, value_key, check)
             continue
-        value = cs.get(name, float, None, check=in_range(-30.0, 30.0))
+        value = cs.get(name, float, None, check=check)
         if value is not None:
             out[name] = value
     cs.done()
@@ -303,10 +299,6 @@ def _satellite_cn0_offset(cs: Section, sigs: list[str]) -> dict:
         out[name] = table
     cs.done()
     return out
-
-
-def _code_scale_table(t: Section) -> tuple:
-    return _angle_table(t, "elevation_deg", (-90.0, 90.0), "factor", non_negative)
 
 
 def _angle_table(t: Section, angle_key: str, bounds: tuple, value_key: str, check) -> tuple:

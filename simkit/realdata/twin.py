@@ -547,16 +547,17 @@ def toml_fragment(p: dict) -> str:
              f"correlation_time_s = {p['mp_correlation_time_s']:.1f}", "",
              "# each signal's multipath correlation time (s)", "[gnss.multipath.signal_correlation_time_s]",
              *(f"{k} = {v:.1f}" for k, v in p.get("mp_signal_correlation_time_s", {}).items()), "",
-             "[gnss.code_error_scale]", *(f"{k} = {_scale_toml(v)}" for k, v in p.get("code_error_scale", {}).items()),
+             "[gnss.code_error_scale]", *(f"{k} = {_table_toml(v, 'elevation_deg', 'factor', '.4f')}"
+                                        for k, v in p.get("code_error_scale", {}).items()),
              "", "# the receiver's C/N0 per signal beyond the signal table's offsets (by the angle from boresight where "
              "one pattern does not serve every signal)",
-             "[gnss.cn0_offset_db]", *(f"{k} = {_offset_toml(v)}" for k, v in cn0_offset_entries(p).items()),
+             "[gnss.cn0_offset_db]", *(f"{k} = {_table_toml(v, 'off_boresight_deg', 'offset_db', '.2f')}"
+                                     for k, v in cn0_offset_entries(p).items()),
              *_satellite_offsets_toml(p.get("satellite_cn0_offset_db", {})),
              "",
              "[[gnss.antenna]]", "lever_arm_m = [0.0, 0.0, 0.0]",
              f"rolloff_db = {p['rolloff_db']:.2f}" if not p.get("gain_pattern") else
-             f"gain_pattern = {{off_boresight_deg = [{', '.join(f'{x:g}' for x in p['gain_pattern'][0])}], "
-             f"gain_db = [{', '.join(f'{x:.2f}' for x in p['gain_pattern'][1])}]}}"]
+             f"gain_pattern = {_table_toml(p['gain_pattern'], 'off_boresight_deg', 'gain_db', '.2f')}"]
     if p.get("iono_residual_fraction") is not None:
         lines += ["", "# the real ionosphere against Klobuchar (dual-frequency geometry-free, carrier-levelled code)",
                   "[gnss.truth_errors]", f"iono_residual_fraction = {p['iono_residual_fraction']:.4f}"]
@@ -607,18 +608,15 @@ def _satellite_offsets_toml(tables: dict) -> list:
     return lines
 
 
-def _offset_toml(v) -> str:
+def _table_toml(v, angle_key: str, value_key: str, fmt: str) -> str:
+    """A number, or an angle table (an (angles, values) pair, a list of two lists when read back from JSON, or the
+    dict {angle_key: ..., value_key: ...}), as a TOML value; values written with ``fmt``."""
     if isinstance(v, dict):
-        return (f"{{off_boresight_deg = [{', '.join(f'{a:g}' for a in v['off_boresight_deg'])}], "
-                f"offset_db = [{', '.join(f'{o:.2f}' for o in v['offset_db'])}]}}")
-    return f"{v:.2f}"
-
-
-def _scale_toml(v) -> str:
-    if isinstance(v, (tuple, list)):   # (elevation_deg, factor); a list of two lists when read back from JSON
-        return (f"{{elevation_deg = [{', '.join(f'{e:g}' for e in v[0])}], "
-                f"factor = [{', '.join(f'{f:.4f}' for f in v[1])}]}}")
-    return f"{v:.4f}"
+        v = (v[angle_key], v[value_key])
+    if isinstance(v, (tuple, list)):
+        return (f"{{{angle_key} = [{', '.join(f'{a:g}' for a in v[0])}], "
+                f"{value_key} = [{', '.join(format(x, fmt) for x in v[1])}]}}")
+    return format(v, fmt)
 
 
 def _twin_once(real, ref, nav_paths, mask, params, seed, path, progress, arrays=False):
