@@ -4,8 +4,9 @@ from __future__ import annotations
 from . import jitcache
 from .version import __version__
 
-jitcache.choose()  # before any numba kernel is defined: a read-only install still caches them
-jitcache.register_when_numba_loads()  # the prepared cache (`simkit compile`) seeds numba's, content-keyed
+# when numba loads, before any kernel is defined: a cache directory even in a read-only install (jitcache.choose),
+# seeded from the prepared cache (`simkit compile`), content-keyed
+jitcache.register_when_numba_loads()
 
 __all__ = ["__version__", "campaign", "open", "run", "score", "solve", "validate"]
 

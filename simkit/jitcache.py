@@ -3,10 +3,10 @@
 numba looks for a cache directory per source file: ``$NUMBA_CACHE_DIR`` when set, else ``__pycache__`` next to
 the source when writable, else the user's cache directory (``$XDG_CACHE_HOME/numba``, ``~/.cache/numba``). In a
 container or a cluster image both of the last two can be read-only; numba then refuses every ``cache=True``
-function at import ("no locator available"), and simkit could not even be imported. :func:`choose` runs once at
-``import simkit``, before any kernel is defined: with ``$NUMBA_CACHE_DIR`` unset and neither directory writable,
-it points numba at ``<temporary directory>/simkit-numba-<uid>`` (also exported, so that worker processes started
-from this one share it). Compiled code is keyed by source, CPU and numba version, so a shared directory is safe.
+function at import ("no locator available"), and simkit could not even be imported. :func:`choose` runs once,
+when numba is imported (``import simkit`` arranges it), before any kernel is defined: with ``$NUMBA_CACHE_DIR``
+unset and neither directory writable, it points numba at ``<temporary directory>/simkit-numba-<uid>`` (also
+exported, so that worker processes started from this one share it). Compiled code is keyed by source, CPU and numba version, so a shared directory is safe.
 
 A prepared cache (docs/cold_start.md): ``simkit compile`` runs the kernels a first run needs once and stores
 what numba compiled in ``simkit/_jit`` (a tree mirroring the package's). :func:`register` (also at ``import
@@ -23,11 +23,8 @@ numpy or numba version
 from __future__ import annotations
 
 import functools
-import hashlib
 import os
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parent
@@ -36,6 +33,8 @@ PREPARED = _PACKAGE / "_jit"  # the prepared cache, filled by `simkit compile` (
 
 def writable(directory: Path) -> bool:
     """True when a file can be created in ``directory`` (created if missing), the test numba itself applies."""
+    import tempfile
+
     try:
         directory.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=directory):
@@ -53,6 +52,8 @@ def user_cache_dir() -> Path:
 
 def fallback_dir() -> Path:
     """The cache directory used when numba has none: per user, under the system's temporary directory."""
+    import tempfile
+
     uid = os.getuid() if hasattr(os, "getuid") else os.getlogin()
     return Path(tempfile.gettempdir()) / f"simkit-numba-{uid}"
 
@@ -74,6 +75,8 @@ def choose() -> Path | None:
 def source_stamp(py_file: str) -> tuple[str, str]:
     """The stamp numba stores in a kernel's cache index and compares at load: (SHA-256 of the source file,
     numpy's version). No mtime, no path: a copied or reinstalled package keeps its cache."""
+    import hashlib
+
     import numpy
 
     with open(py_file, "rb") as f:
@@ -84,6 +87,8 @@ def sources_digest(package: Path = _PACKAGE) -> str:
     """SHA-256 over every ``.py`` file of the package (relative path and contents). ``simkit compile`` stores it
     with the prepared cache, which seeds numba's only while the sources are still these: numba's stamp covers a
     kernel's own file, not the callees compiled into it from other files."""
+    import hashlib
+
     digest = hashlib.sha256()
     for path in sorted(p for p in package.rglob("*.py") if PREPARED.name not in p.relative_to(package).parts):
         digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
@@ -117,6 +122,9 @@ def seed(prepared: str, cache: str, base: str) -> int:
     names = [n for n in _listing(prepared) if n.startswith(base + ".") and n.endswith(".nbc")]
     if base + ".nbi" not in _listing(prepared):
         return 0
+    import shutil
+    import tempfile
+
     copied = 0
     for name in names + [base + ".nbi"]:
         fd, tmp = tempfile.mkstemp(dir=cache, prefix=".seed-")
@@ -212,7 +220,7 @@ def register():
 
 
 class _RegisterAfterNumba:
-    """A ``sys.meta_path`` finder that calls :func:`register` right after numba's package has been executed, so
+    """A ``sys.meta_path`` finder that calls :func:`choose` and :func:`register` right after numba's package has been executed, so
     that ``import simkit`` does not import numba (a truth + IMU run never needs it) and still every simkit kernel,
     defined after numba is imported, gets the locator."""
 
@@ -229,7 +237,8 @@ class _RegisterAfterNumba:
 
 
 class _ThenRegister:
-    """numba's loader, then :func:`register`."""
+    """numba's loader, then :func:`choose` (numba's configuration is loaded: it sets ``config.CACHE_DIR`` too)
+    and :func:`register`."""
 
     def __init__(self, loader):
         self._loader = loader
@@ -239,6 +248,7 @@ class _ThenRegister:
 
     def exec_module(self, module):
         self._loader.exec_module(module)
+        choose()
         register()
 
     def __getattr__(self, name):
@@ -246,8 +256,10 @@ class _ThenRegister:
 
 
 def register_when_numba_loads() -> None:
-    """:func:`register` now when numba is imported already, else right after it is (once)."""
+    """:func:`choose` and :func:`register` now when numba is imported already, else right after it is (once): a
+    process that never loads numba (a truth + IMU run) neither tests a directory nor imports what it needs."""
     if "numba" in sys.modules:
+        choose()
         register()
     elif not any(isinstance(f, _RegisterAfterNumba) for f in sys.meta_path):
         sys.meta_path.insert(0, _RegisterAfterNumba())

@@ -53,3 +53,28 @@ def test_chunk_aligned_blocks_handed_over_or_copied_and_reused_buffers(tmp_path)
             assert white.get_num_chunks() == force.get_num_chunks() == 4
             assert {white.get_chunk_info(i).filter_mask for i in range(4)} == {SKIP_FILTERS}
             assert {force.get_chunk_info(i).filter_mask for i in range(4)} == {0}
+
+
+def test_chunks_of_zero_bytes_are_not_written_and_read_back_as_zero(tmp_path):
+    """A compressed series' chunk whose bytes are all zero (a saturation term that never clips) is left unwritten:
+    HDF5 and h5py read it as the fill value 0. A chunk of -0.0 (not zero bytes) and a chunk that is zero but for
+    its last element are written, so every bit reads back; a series that starts with a zero chunk is still
+    compressed, not raw."""
+    rows = CHUNK_ROWS
+    data = np.zeros((5 * rows + 17, 3))
+    data[rows:2 * rows] = -0.0
+    data[3 * rows - 1, 2] = 1e-300
+    data[4 * rows:] = np.cumsum(np.full((rows + 17, 3), 1e-3), axis=0)
+    for threads in (1, 2):
+        path = tmp_path / f"z{threads}.h5"
+        with Writer(path, {}, threads=threads) as w:
+            for a in range(0, len(data), 40_000):
+                w.append("imu/errors/gyro_saturation", data[a:a + 40_000])
+        with h5py.File(path, "r") as f:
+            ds = f["imu/errors/gyro_saturation"]
+            got = ds[...]
+            assert got.view(np.uint64).tobytes() == data.view(np.uint64).tobytes()   # -0.0 keeps its sign bit
+            assert ds.id.get_num_chunks() == 4                                       # chunks 1, 2, 4, 5 of 6
+            written = [ds.id.get_chunk_info(i) for i in range(4)]
+            assert [c.chunk_offset[0] // rows for c in written] == [1, 2, 4, 5]
+            assert {c.filter_mask for c in written} == {0}

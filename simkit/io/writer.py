@@ -46,9 +46,25 @@ def _chunks(shape, itemsize):
     return (rows,) + tuple(shape[1:])
 
 
-def _first_chunk(chunk: np.ndarray, valid: int) -> tuple[bytes | np.ndarray, int]:
+def _all_zero(chunk: np.ndarray) -> bool:
+    """Whether every byte of ``chunk`` is zero (-0.0 is not): its first element decides at once for most chunks."""
+    raw = chunk.reshape(-1).view(np.uint8)
+    return not raw[:chunk.itemsize].any() and not raw.any()
+
+
+def _deflated(chunk: np.ndarray, valid: int) -> bytes | None:
+    """The stored bytes of a compressed series' chunk, or None when all its bytes are zero: such a chunk is not
+    written (HDF5 reads a chunk never written as the dataset's fill value, 0), e.g. the saturation term of an IMU
+    that never saturates."""
+    return None if _all_zero(chunk) else shuffle_deflate(chunk, valid)
+
+
+def _first_chunk(chunk: np.ndarray, valid: int) -> tuple[bytes | np.ndarray | None, int]:
     """(what to store, filter mask) of a series' first chunk (``valid`` rows before its padding): shuffled and
-    deflated, or raw when that does not pay (COMPRESS_MAX_RATIO); the series follows this choice."""
+    deflated (None when all zero, as :func:`_deflated`), or raw when that does not pay (COMPRESS_MAX_RATIO); the
+    series follows this choice."""
+    if _all_zero(chunk):
+        return None, 0
     packed = shuffle_deflate(chunk, valid)
     return (chunk, SKIP_FILTERS) if len(packed) > COMPRESS_MAX_RATIO * chunk.nbytes else (packed, 0)
 
@@ -216,7 +232,7 @@ class Writer:
             series.probe = self._pool.submit(_first_chunk, chunk, valid)
             self._jobs.append((series.ds, offset, series.probe, None, chunk.nbytes))
         else:
-            self._jobs.append((series.ds, offset, self._pool.submit(shuffle_deflate, chunk, valid), 0,
+            self._jobs.append((series.ds, offset, self._pool.submit(_deflated, chunk, valid), 0,
                                chunk.nbytes))
         self._held += chunk.nbytes
 
@@ -225,7 +241,8 @@ class Writer:
         while self._jobs and (self._held > keep or self._jobs[0][2].done()):
             ds, offset, job, mask, held = self._jobs.popleft()
             data, mask = job.result() if mask is None else (job.result(), mask)  # None: a first chunk's job
-            ds.id.write_direct_chunk(offset, data, filter_mask=mask)
+            if data is not None:
+                ds.id.write_direct_chunk(offset, data, filter_mask=mask)
             self._held -= held
 
     def write(self, name: str, data, attrs: dict | None = None) -> None:

@@ -125,12 +125,13 @@ class Trajectory:
         k = slice(skip, None)  # views: the truth is formed sample by sample
         truth = self._assemble(t[k], {name: v[k] for name, v in cn.items()}, speed[k],
                                Trig(*(x[k] for x in g_t)), Trig(*(x[k] for x in p_t)), rollx[k],
-                               np.stack([ve, vn, vu], axis=-1)[k], lat[k], sl[k], cl[k], rn[k], lon[k], hgt[k])
+                               (ve[k], vn[k], vu[k]), lat[k], sl[k], cl[k], rn[k], lon[k], hgt[k])
         end = np.array([speed[-1], gamma[-1], psi[-1], rollx[-1], lat[-1], lon[-1], hgt[-1]])
         return truth, end
 
-    def _assemble(self, t, cmd, speed, gamma: Trig, psi: Trig, rollx, vel_enu, lat, sin_lat, cos_lat, rn, lon,
+    def _assemble(self, t, cmd, speed, gamma: Trig, psi: Trig, rollx, vel, lat, sin_lat, cos_lat, rn, lon,
                   hgt) -> TrajectoryTruth:
+        """The truth block from the integrated states; ``vel``: the E, N, U velocity components, (N,) m/s each."""
         gamma_dot, psi_dot = cmd["pitch_rate"], cmd["turn_rate"]
         cg, sg, cp, sp = gamma.cos, gamma.sin, psi.cos, psi.sin
         if self.cfg.coordinated_turns:
@@ -144,19 +145,25 @@ class Trajectory:
         roll_dot = bank_dot + cmd["roll_rate"]
 
         accel, v_gamma, v_psi = cmd["accel"], speed * gamma_dot, speed * psi_dot  # dv/dt = a u_v + V d(u_v)/dt
-        acc_enu = np.stack([accel * (cg * sp) + v_gamma * (-sg * sp) + v_psi * (cg * cp),
-                            accel * (cg * cp) + v_gamma * (-sg * cp) + v_psi * (-cg * sp),
-                            accel * sg + v_gamma * cg], -1)
+        acc = (accel * (cg * sp) + v_gamma * (-sg * sp) + v_psi * (cg * cp),
+               accel * (cg * cp) + v_gamma * (-sg * cp) + v_psi * (-cg * sp),
+               accel * sg + v_gamma * cg)
 
-        w_ie = earth.earth_rate_enu(lat, sin_lat, cos_lat)
-        w_en = earth.transport_rate_enu(lat, hgt, vel_enu, sin_lat)
-        f_n = acc_enu + np.cross(2.0 * w_ie + w_en, vel_enu) - earth.gravity_enu(lat, hgt, sin_lat)
+        # earth.earth_rate_enu, earth.transport_rate_enu and f^n = dv/dt + (2 w_ie + w_en) x v - g^n, by component
+        ve, vn, vu = vel
+        rm, _ = earth.radii(lat, sin_lat)
+        w_ie_n, w_ie_u = earth.OMEGA_E * cos_lat, earth.OMEGA_E * sin_lat
+        w_en = (-vn / (rm + hgt), ve / (rn + hgt), ve * np.tan(lat) / (rn + hgt))
+        o_e, o_n, o_u = w_en[0], 2.0 * w_ie_n + w_en[1], 2.0 * w_ie_u + w_en[2]
+        f_n = (acc[0] + (o_n * vu - o_u * vn), acc[1] + (o_u * ve - o_e * vu),
+               acc[2] + (o_e * vn - o_n * ve) + earth.normal_gravity(lat, hgt, sin_lat))
+        w_in = (w_en[0], w_ie_n + w_en[1], w_ie_u + w_en[2])
         quat_nb, euler, omega_ib_b, f_ib_b = body_truth(gamma, trig(roll), psi, (gamma_dot, roll_dot, psi_dot),
-                                                        w_ie + w_en, f_n)
+                                                        w_in, f_n)
 
         pos_lla = np.stack([lat, lon, hgt], axis=-1)
         r_cos = (rn + hgt) * cos_lat  # geodetic -> ECEF with the prime-vertical radius rn at hand
         s_lon, c_lon = sin_cos(lon)
         pos_ecef = np.stack([r_cos * c_lon, r_cos * s_lon, (rn * (1.0 - earth.E2) + hgt) * sin_lat], -1)
-        return TrajectoryTruth(t=t, pos_ecef=pos_ecef, pos_lla=pos_lla, vel_enu=vel_enu,
+        return TrajectoryTruth(t=t, pos_ecef=pos_ecef, pos_lla=pos_lla, vel_enu=np.stack(vel, axis=-1),
                                quat_nb=quat_nb, euler=euler, omega_ib_b=omega_ib_b, f_ib_b=f_ib_b)

@@ -316,7 +316,7 @@ class LoggedPath:
         w_ie = earth.earth_rate_enu(lat)
         f_n = a_n + np.cross(2.0 * w_ie + w_en, v_n) - earth.gravity_enu(lat, hgt)
         quat, euler, omega, f_b = body_truth(trig(gamma), trig(roll), trig(psi), (gamma_dot, roll_dot, psi_dot),
-                                             w_ie + w_en, f_n)
+                                             (w_ie + w_en).T, f_n.T)
         return TrajectoryTruth(t=t, pos_ecef=r_e, pos_lla=lla, vel_enu=v_n, quat_nb=quat, euler=euler,
                                omega_ib_b=omega, f_ib_b=f_b)
 

@@ -81,23 +81,27 @@ def body_truth(pitch: Trig, roll: Trig, heading: Trig, rates, w_in_n, f_n):
     :func:`trig` (any range: a loop's pitch passes 90 deg) and their ``rates`` (pitch, roll, heading) rad/s:
     ``quat_nb`` (N, 4) scalar-last, unit; ``euler`` (N, 3) [pitch in [-pi/2, pi/2], roll in (-pi, pi], heading
     in [0, 2 pi)] rad, the same attitude; ``omega_ib_b`` = w_nb^b + C_n^b ``w_in_n`` and ``f_ib_b`` = C_n^b
-    ``f_n`` (N, 3), rad/s and m/s^2.
+    ``f_n`` (N, 3), rad/s and m/s^2. ``w_in_n`` and ``f_n``: their E, N and U components, three (N,) arrays each
+    (an (N, 3) array's transpose will do).
 
     The matrix is written out from the sines and cosines, and the Euler triple read from the angles in closed
     form (past 90 deg of pitch: pitch pi - gamma, roll and heading turned by pi), so no rotation object is built
-    and no angle is recovered from a matrix (which loses digits near 90 deg of pitch)."""
+    and no angle is recovered from a matrix (which loses digits near 90 deg of pitch). The body vectors are
+    formed component by component, each an N-long loop over contiguous arrays, and interleaved once."""
     sp, cp, sr, cr, sh, ch = pitch.sin, pitch.cos, roll.sin, roll.cos, heading.sin, heading.cos
     c = ((ch * cr + sh * sp * sr, sh * cp, ch * sr - sh * sp * cr),          # rows of C_b^n
          (ch * sp * sr - sh * cr, ch * cp, -sh * sr - ch * sp * cr),
          (-cp * sr, sp, cp * cr))
 
-    def to_body(v):  # C_n^b v = (C_b^n)^T v
-        return np.stack([c[0][j] * v[:, 0] + c[1][j] * v[:, 1] + c[2][j] * v[:, 2] for j in range(3)], axis=-1)
+    def to_body(v):  # C_n^b v = (C_b^n)^T v, by component
+        e, n, u = v
+        return [c[0][j] * e + c[1][j] * n + c[2][j] * u for j in range(3)]
 
     pitch_dot, roll_dot, heading_dot = rates
     yaw_dot = -heading_dot
-    w_nb = np.stack([cr * pitch_dot - sr * cp * yaw_dot, sp * yaw_dot + roll_dot, sr * pitch_dot + cr * cp * yaw_dot],
-                    axis=-1)                                                 # as body_rate_nb
+    w_nb = (cr * pitch_dot - sr * cp * yaw_dot, sp * yaw_dot + roll_dot,   # as body_rate_nb
+            sr * pitch_dot + cr * cp * yaw_dot)
+    omega = np.stack([a + b for a, b in zip(w_nb, to_body(w_in_n))], axis=-1)
 
     # q_z(-heading) q_x(pitch) q_y(roll) written out, as frames.quat_from_euler
     sx, cx, sy, cy, sz, cz = pitch.half_sin, pitch.half_cos, roll.half_sin, roll.half_cos, -heading.half_sin, \
@@ -108,4 +112,4 @@ def body_truth(pitch: Trig, roll: Trig, heading: Trig, rates, w_in_n, f_n):
     s = np.where(cp < 0.0, -1.0, 1.0)
     euler = np.stack([np.arctan2(sp, np.abs(cp)), np.arctan2(s * sr, s * cr),
                       frames.wrap_2pi(np.arctan2(s * sh, s * ch))], axis=-1)
-    return quat, euler, w_nb + to_body(w_in_n), to_body(f_n)
+    return quat, euler, omega, np.stack(to_body(f_n), axis=-1)
