@@ -75,7 +75,7 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
     with _truth_lane(traj.blocks(block_samples=block_samples), ahead=threads > 1) as truth:
         stages = build(sc, sky, traj)
         with Writer(out, root_attributes(sc), threads) as w:
-            _write(w, sc, stages, truth, progress, ahead=threads > 1)
+            _write(w, sc, stages, truth, progress, ahead=threads > 1, imu_ahead=TRUTH_AHEAD * block_samples)
     return out
 
 
@@ -262,10 +262,14 @@ def _truth_lane(blocks: Iterator, ahead: bool, depth: int = TRUTH_AHEAD) -> Iter
         worker.shutdown(wait=True, cancel_futures=True)
 
 
-def _write(w: Writer, sc: Scenario, stages: Stages, truth: Iterator, progress: bool, ahead: bool = False) -> None:
+def _write(w: Writer, sc: Scenario, stages: Stages, truth: Iterator, progress: bool, ahead: bool = False,
+           imu_ahead: int = 0) -> None:
     """Every block of the run into ``w``: truth and IMU rows per ``truth`` block, then the GNSS epochs of each block
-    (``ahead``: the next GNSS slice's geometry on a worker thread)."""
+    (``ahead``: the next GNSS slice's geometry on a worker thread, and the IMU noise of the first ``imu_ahead``
+    samples drawn while the truth worker computes the first blocks: this thread would wait for them idle)."""
     _write_static(w, sc, stages)
+    if ahead and stages.imu is not None:
+        stages.imu.draw_ahead(min(imu_ahead, stages.trajectory.n_samples()))
     bar = None
     if progress:
         from tqdm import tqdm

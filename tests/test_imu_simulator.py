@@ -106,6 +106,32 @@ def test_blocks_give_identical_arrays(output):
         np.testing.assert_array_equal(one.errors[name], np.concatenate([p.errors[name] for p in parts]))
 
 
+def test_noise_drawn_ahead_gives_the_same_record():
+    """The truth-independent terms (vibration, turn-on and bias sources, white) drawn ahead in pieces that do not
+    match the blocks (the pipeline draws them while the truth worker computes) give the record of no draw-ahead,
+    bit for bit; a sensor without such terms draws nothing."""
+    t, omega, f = truth(12345)
+    vib = [[5.0, 1e-4], [50.0, 1e-3], [90.0, 1e-4]]
+    c = cfg({**ALL_TERMS, "accel": {**ALL_TERMS["accel"], "vibration_psd_g2_per_hz": vib}})
+    one = ImuSimulator(c, 200.0, 42).process(t, omega, f)
+    sim = ImuSimulator(c, 200.0, 42)
+    sim.draw_ahead(500)
+    sim.draw_ahead(3000)
+    cuts, parts = [0, 1001, 1002, 7000, 12345], []
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        parts.append(sim.process(t[a:b], omega[a:b], f[a:b]))
+        sim.draw_ahead(2500 if a == 0 else 0)
+    assert not sim.gyro.drawn and not sim.accel.drawn
+    assert {"accel_vibration", "gyro_bias", "accel_white"} <= set(one.errors)
+    for name in ("gyro", "accel"):
+        np.testing.assert_array_equal(getattr(one, name), np.concatenate([getattr(p, name) for p in parts]))
+    for name in one.errors:
+        np.testing.assert_array_equal(one.errors[name], np.concatenate([p.errors[name] for p in parts]))
+    ideal = ImuSimulator(cfg({"preset": "ideal"}), 200.0, 1)
+    ideal.draw_ahead(100)
+    assert not ideal.gyro.drawn and not ideal.accel.drawn
+
+
 def test_deterministic_and_seed_dependent():
     t, omega, f = truth(2000)
     a = ImuSimulator(cfg(ALL_TERMS), 200.0, 5).process(t, omega, f)

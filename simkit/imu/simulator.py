@@ -104,6 +104,42 @@ class _Sensor:
         self.lowpass = LowPass(s.bandwidth_hz, dt) if 0 < s.bandwidth_hz < nyquist else None
         self.quantizer = Quantizer(s.quantization) if s.quantization > 0 else None
         self.prev = None  # last two truth samples, for increments
+        self.drawn: list[tuple] = []  # drawn ahead (draw_ahead), in order: (samples, vibration, bias, white)
+
+    def _draw(self, n: int) -> tuple:
+        """The next ``n`` samples of the terms that do not depend on the truth: (n, vibration, bias, white), each
+        (n, 3) or None when the sensor has no such term; bias = turn-on + its sources."""
+        vibration = self.vibration.block(n) if self.vibration is not None else None
+        bias = None
+        if self.turn_on is not None or self.bias_sources:
+            bias = np.broadcast_to(self.turn_on if self.turn_on is not None else 0.0, (n, 3)).copy()
+            for src in self.bias_sources:
+                bias += src.block(n)
+        return n, vibration, bias, self.white.block(n) if self.white is not None else None
+
+    def draw_ahead(self, n: int) -> None:
+        """Draw the truth-independent terms of the next ``n`` samples now (each term's own stream, so the record
+        is the same samples whenever they are drawn); :meth:`process` uses them first."""
+        if n > 0 and (self.vibration is not None or self.turn_on is not None or self.bias_sources
+                      or self.white is not None):
+            self.drawn.append(self._draw(n))
+
+    def _terms(self, n: int) -> tuple:
+        """(vibration, bias, white) of the next ``n`` samples: those drawn ahead first, then fresh draws."""
+        parts, have = [], 0
+        while self.drawn and have < n:
+            m, *terms = self.drawn.pop(0)
+            if have + m > n:  # keep the rest for the next block (views: nothing writes into these arrays)
+                cut = n - have
+                self.drawn.insert(0, (m - cut, *(None if x is None else x[cut:] for x in terms)))
+                terms, m = [None if x is None else x[:cut] for x in terms], cut
+            parts.append(terms)
+            have += m
+        if have < n:
+            parts.append(self._draw(n - have)[1:])
+        if len(parts) == 1:
+            return tuple(parts[0])
+        return tuple(None if p[0] is None else np.concatenate(p) for p in zip(*parts))
 
     def process(self, x: np.ndarray, f: np.ndarray):
         """Measured rates (N, 3), error terms {name: (N, 3)} and, in increments mode, the measured increments."""
@@ -118,22 +154,20 @@ class _Sensor:
         if self.g_matrix is not None:
             errors["g_sensitivity"] = _apply(self.g_matrix, f)
             signal = signal + errors["g_sensitivity"]
-        if self.vibration is not None:
-            errors["vibration"] = self.vibration.block(n)
-            signal = signal + errors["vibration"]
+        vibration, bias, white = self._terms(n)
+        if vibration is not None:
+            errors["vibration"] = vibration
+            signal = signal + vibration
         y = signal
         if self.lowpass is not None:
             y = self.lowpass.block(signal)
             errors["bandwidth"] = y - signal
-        if self.turn_on is not None or self.bias_sources:
-            bias = np.broadcast_to(self.turn_on if self.turn_on is not None else 0.0, (n, 3)).copy()
-            for src in self.bias_sources:
-                bias += src.block(n)
+        if bias is not None:
             errors["bias"] = bias
             y = y + bias
-        if self.white is not None:
-            errors["white"] = self.white.block(n)
-            y = y + errors["white"]
+        if white is not None:
+            errors["white"] = white
+            y = y + white
         if s.range > 0:
             clipped = np.clip(y, -s.range, s.range)
             errors["saturation"] = clipped - y
@@ -168,6 +202,12 @@ class ImuSimulator:
         inc = cfg.output == "increments"
         self.gyro = _Sensor("gyro", cfg.gyro, self.dt, seed, inc)
         self.accel = _Sensor("accel", cfg.accel, self.dt, seed, inc)
+
+    def draw_ahead(self, n: int) -> None:
+        """Draw the noise of the next ``n`` samples (the terms that do not depend on the truth) now, e.g. while
+        the truth is computed elsewhere; the output is the same as without."""
+        self.gyro.draw_ahead(n)
+        self.accel.draw_ahead(n)
 
     def process(self, t: np.ndarray, omega_ib_b: np.ndarray, f_ib_b: np.ndarray) -> ImuBlock:
         """Measure one block of truth.
