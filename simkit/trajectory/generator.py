@@ -98,9 +98,22 @@ class Trajectory:
     def _integrate(self, t, h, state, skip: int):
         """Integrate from ``state`` at t[0] over the nodes ``t``; returns the truth at the nodes from ``skip`` on
         and the state at t[-1]."""
+        cn = self._commands(t)
+        speed, gamma, psi, rollx, g_t, p_t, (ve, vn, vu), hgt, lat, sl, cl, rn, lon = self._states(t, h, state, cn)
+        k = slice(skip, None)  # views: the truth is formed sample by sample
+        truth = self._assemble(t[k], {name: v[k] for name, v in cn.items()}, speed[k],
+                               Trig(*(x[k] for x in g_t)), Trig(*(x[k] for x in p_t)), rollx[k],
+                               (ve[k], vn[k], vu[k]), lat[k], sl[k], cl[k], rn[k], lon[k], hgt[k])
+        end = np.array([speed[-1], gamma[-1], psi[-1], rollx[-1], lat[-1], lon[-1], hgt[-1]])
+        return truth, end
+
+    def _states(self, t, h, state, cn):
+        """The integrated states at the nodes ``t`` from ``state`` at t[0], with the commands ``cn`` there: speed,
+        gamma, psi, extra roll, trig(gamma), trig(psi), the E, N, U velocity, height, latitude with its sine and
+        cosine, R_N, longitude. The midpoint values live only here (a block's memory peak: 60 MB at 65,536
+        samples before, when they lived on through the assembly)."""
         v0, g0_, p0, r0, lat0, lon0, h0 = state
-        tm = t[:-1] + 0.5 * h
-        cn, cm = self._commands(t), self._commands(tm)
+        cm = self._commands(t[:-1] + 0.5 * h)
         speed, speed_m = _cumulative(v0, cn["accel"], cm["accel"], h)
         gamma, gamma_m = _cumulative(g0_, cn["pitch_rate"], cm["pitch_rate"], h)
         psi, psi_m = _cumulative(p0, cn["turn_rate"], cm["turn_rate"], h)
@@ -121,13 +134,7 @@ class Trajectory:
         _, rn = earth.radii(lat, sl)
         _, rn_m = earth.radii(lat_m, sl_m)
         lon, _ = _cumulative(lon0, ve / ((rn + hgt) * cl), ve_m / ((rn_m + hgt_m) * cl_m), h)
-
-        k = slice(skip, None)  # views: the truth is formed sample by sample
-        truth = self._assemble(t[k], {name: v[k] for name, v in cn.items()}, speed[k],
-                               Trig(*(x[k] for x in g_t)), Trig(*(x[k] for x in p_t)), rollx[k],
-                               (ve[k], vn[k], vu[k]), lat[k], sl[k], cl[k], rn[k], lon[k], hgt[k])
-        end = np.array([speed[-1], gamma[-1], psi[-1], rollx[-1], lat[-1], lon[-1], hgt[-1]])
-        return truth, end
+        return speed, gamma, psi, rollx, g_t, p_t, (ve, vn, vu), hgt, lat, sl, cl, rn, lon
 
     def _assemble(self, t, cmd, speed, gamma: Trig, psi: Trig, rollx, vel, lat, sin_lat, cos_lat, rn, lon,
                   hgt) -> TrajectoryTruth:
