@@ -6,11 +6,12 @@ container or a cluster image both of the last two can be read-only; numba then r
 function at import ("no locator available"), and simkit could not even be imported. :func:`choose` runs once,
 when numba is imported (``import simkit`` arranges it), before any kernel is defined: with ``$NUMBA_CACHE_DIR``
 unset and neither directory writable, it points numba at ``<temporary directory>/simkit-numba-<uid>`` (also
-exported, so that worker processes started from this one share it). Compiled code is keyed by source, CPU and numba version, so a shared directory is safe.
+exported, so that worker processes started from this one share it). Compiled code is keyed by source, CPU and
+numba version, so a shared directory is safe.
 
 A prepared cache (docs/cold_start.md): ``simkit compile`` runs the kernels a first run needs once and stores
-what numba compiled in ``simkit/_jit`` (a tree mirroring the package's). :func:`register` (also at ``import
-simkit``) puts :class:`PreparedLocator` first in numba's list of cache locators, for simkit's own source files
+what numba compiled in ``simkit/_jit`` (a tree mirroring the package's). :func:`register` (also when numba
+loads) puts :class:`PreparedLocator` first in numba's list of cache locators, for simkit's own source files
 only: it keeps numba's choice of directory, and when that directory has no index for a kernel yet, copies the
 prepared files there first (an empty ``$NUMBA_CACHE_DIR``, a read-only install, a new user: numba then loads
 instead of compiling). The source stamp is the SHA-256 of the source file and numpy's version: a prepared
@@ -220,9 +221,9 @@ def register():
 
 
 class _RegisterAfterNumba:
-    """A ``sys.meta_path`` finder that calls :func:`choose` and :func:`register` right after numba's package has been executed, so
-    that ``import simkit`` does not import numba (a truth + IMU run never needs it) and still every simkit kernel,
-    defined after numba is imported, gets the locator."""
+    """A ``sys.meta_path`` finder that calls :func:`choose` and :func:`register` right after numba's package has
+    been executed, so that ``import simkit`` does not import numba (a truth + IMU run never needs it) and still
+    every simkit kernel, defined after numba is imported, gets the locator and a cache directory."""
 
     def find_spec(self, name, path=None, target=None):
         if name != "numba":

@@ -110,8 +110,8 @@ class Trajectory:
     def _states(self, t, h, state, cn):
         """The integrated states at the nodes ``t`` from ``state`` at t[0], with the commands ``cn`` there: speed,
         gamma, psi, extra roll, trig(gamma), trig(psi), the E, N, U velocity, height, latitude with its sine and
-        cosine, R_N, longitude. The midpoint values live only here (a block's memory peak: 60 MB at 65,536
-        samples before, when they lived on through the assembly)."""
+        cosine, R_N, longitude. The midpoint values live only here, so they are freed before the block is
+        assembled (its memory peak 47 MB at 65,536 samples, against 60 MB when they lived on)."""
         v0, g0_, p0, r0, lat0, lon0, h0 = state
         cm = self._commands(t[:-1] + 0.5 * h)
         speed, speed_m = _cumulative(v0, cn["accel"], cm["accel"], h)
