@@ -4,12 +4,13 @@ The receiver corrects its code with the broadcast Klobuchar model, which removes
 delay (RMS). The truth therefore departs from it:
 
 * without a map: I_true = k I_Klobuchar exp(s e(x, t) - s^2/2), k the mean ratio (``iono_scale``, 1 by default:
-  at night or at solar minimum the real ionosphere can sit well below the model's floor), where e is a zero-mean, unit-variance Gaussian-like
-  random field of the ionospheric pierce point x (on a 350 km shell, Earth-fixed, km) and time t, with covariance
-  exp(-|dx|^2 / (2 L^2) - dt^2 / (2 tau^2)), built as a sum of 64 random Fourier features (Rahimi and Recht 2007);
-  s = sqrt(ln(1 + f^2)) so that RMS(I_true / I_Klobuchar - 1) = f (``iono_residual_fraction``). The factor is
-  positive (no negative delays) and its mean is 1. The field is a smooth function of position and time, so the
-  delay rate is consistent with the delay and the output does not depend on how epochs are split into blocks.
+  at night or at solar minimum the real ionosphere can sit well below the model's floor), where e is a zero-mean,
+  unit-variance Gaussian-like random field of the ionospheric pierce point x (on a 350 km shell, Earth-fixed,
+  km) and time t, with covariance exp(-|dx|^2 / (2 L^2) - dt^2 / (2 tau^2)), built as a sum of 64 random Fourier
+  features (Rahimi and Recht 2007); s = sqrt(ln(1 + f^2)) so that RMS(I_true / (k I_Klobuchar) - 1) = f
+  (``iono_residual_fraction``). The random factor is positive (no negative delays) and its mean is 1. The field
+  is a smooth function of position and time, so the delay rate is consistent with the delay and the output does
+  not depend on how epochs are split into blocks.
 * with an IONEX map: I_true = 40.3 VTEC(x, t) / f^2 on the map's shell with the single-layer mapping 1/cos z'.
 
 Rates are central differences over +-``h`` s along the receiver's and the satellites' motion, as in

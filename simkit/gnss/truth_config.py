@@ -49,7 +49,8 @@ class TruthErrorsConfig:
 
 
 _REALISTIC = {
-    "iono_residual_fraction": 0.5, "iono_scale": 1.0, "iono_correlation_length_km": 1000.0, "iono_correlation_time_s": 3600.0,
+    "iono_residual_fraction": 0.5, "iono_scale": 1.0, "iono_correlation_length_km": 1000.0,
+    "iono_correlation_time_s": 3600.0,
     "tropo_mapping": "niell", "tropo_zhd_sigma_m": 0.02, "tropo_zwd_sigma_m": 0.04,
     "tropo_zwd_random_walk_m_per_sqrt_h": 0.01,
     "gps_orbit_sigma_rac_m": [0.15, 0.6, 0.4], "gps_clock_sigma_m": 0.5, "gps_ephemeris_interval_s": 7200.0,

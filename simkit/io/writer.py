@@ -63,9 +63,9 @@ def _first_chunk(chunk: np.ndarray, valid: int) -> tuple[bytes | np.ndarray | No
     """(what to store, filter mask) of a series' first chunk (``valid`` rows before its padding): shuffled and
     deflated (None when all zero, as :func:`_deflated`), or raw when that does not pay (COMPRESS_MAX_RATIO); the
     series follows this choice."""
-    if _all_zero(chunk):
+    packed = _deflated(chunk, valid)
+    if packed is None:
         return None, 0
-    packed = shuffle_deflate(chunk, valid)
     return (chunk, SKIP_FILTERS) if len(packed) > COMPRESS_MAX_RATIO * chunk.nbytes else (packed, 0)
 
 

@@ -98,16 +98,14 @@ def scenario(real: dict, reference, nav_paths, mask_deg: float, params: dict, se
                  "cn0_zenith_dbhz": p["cn0_zenith_dbhz"], "slip_rate_per_h": p["slip_rate_per_h"],
                  "constellation": [{"source": str(Path(n).resolve())} for n in nav_paths],
                  "antenna": [{"lever_arm_m": [0.0, 0.0, 0.0],
-                              **({"gain_pattern": {"off_boresight_deg": list(p["gain_pattern"][0]),
-                                                   "gain_db": list(p["gain_pattern"][1])}}
+                              **({"gain_pattern": _table_entry(p["gain_pattern"], "off_boresight_deg", "gain_db")}
                                  if p.get("gain_pattern") else {"rolloff_db": p["rolloff_db"]})}],
                  "noise": {"dll_bandwidth_hz": p["dll_bandwidth_hz"], "pll_bandwidth_hz": p["pll_bandwidth_hz"],
                            "fll_bandwidth_hz": p["fll_bandwidth_hz"]},
                  "cn0_offset_db": cn0_offset_entries(p),
                  **({"satellite_cn0_offset_db": {k: dict(v) for k, v in p["satellite_cn0_offset_db"].items()}}
                     if p.get("satellite_cn0_offset_db") else {}),
-                 "code_error_scale": {k: {"elevation_deg": list(v[0]), "factor": list(v[1])}
-                                      if isinstance(v, (tuple, list)) else v
+                 "code_error_scale": {k: _table_entry(v, "elevation_deg", "factor")
                                       for k, v in p.get("code_error_scale", {}).items()},
                  "multipath": {"code_sigma_m": p["mp_code_sigma_m"], "carrier_sigma_m": p["mp_carrier_sigma_m"],
                                "elevation_scale_deg": p["mp_elevation_scale_deg"],
@@ -431,7 +429,7 @@ def cn0_offset_entries(p: dict) -> dict:
     its offset (dB)."""
     tables = p.get("cn0_offset_table", {})
     out = {k: v for k, v in p.get("cn0_offset_db", {}).items() if k not in tables}
-    out.update({k: {"off_boresight_deg": list(v[0]), "offset_db": list(v[1])} for k, v in tables.items()})
+    out.update({k: _table_entry(v, "off_boresight_deg", "offset_db") for k, v in tables.items()})
     return out
 
 
@@ -606,6 +604,14 @@ def _satellite_offsets_toml(tables: dict) -> list:
     for name, table in tables.items():
         lines += [f"[gnss.satellite_cn0_offset_db.{name}]", *(f"{k} = {v:.2f}" for k, v in table.items())]
     return lines
+
+
+def _table_entry(v, angle_key: str, value_key: str):
+    """A number as it is, or an angle table (an (angles, values) pair, a list of two lists when read back from
+    JSON) as the scenario's table {angle_key: [...], value_key: [...]}."""
+    if isinstance(v, (tuple, list)):
+        return {angle_key: list(v[0]), value_key: list(v[1])}
+    return v
 
 
 def _table_toml(v, angle_key: str, value_key: str, fmt: str) -> str:
