@@ -8,11 +8,12 @@ The peer (github.com/Aceinna/gnss-ins-sim, not on PyPI; a checkout from ``--peer
 interpreter: ``ins_sim.Sim`` on a motion profile of turns, 200 deg/s rolls and a climbing acceleration at the same
 rate, with the STIM300's bias, ARW/VRW and bias instability (first-order Gauss-Markov, its model), ``run()`` and
 ``results(dir)``, its own output (CSV files). Both are timed as child processes: wall time and CPU time
-(user + system of the child, so threads count). Also printed: the peer's generation alone in memory (``path_gen``
+(user + system of the child, so threads count), in interleaved rounds (simkit's median of 5 runs, then one peer
+run; 3 rounds): the ratio is the median of the rounds' ratios, each round's printed beside it. Also printed: the peer's generation alone in memory (``path_gen``
 + ``gyro_gen`` + ``acc_gen``, no start-up, no file), the strictest comparison, and where simkit's CPU goes (one
-more run, instrumented: start-up, imports, truth, IMU, writes, compression).
+more run, instrumented: start-up, imports, truth, IMU, compression, writes).
 
-    python benchmarks/bench_truth_imu.py [--seconds 600] [--rate 1000] [--peer DIR] [--json OUT]
+    python benchmarks/bench_truth_imu.py [--seconds 600] [--rate 1000] [--peer DIR] [--rounds 3] [--json OUT]
     python benchmarks/bench_truth_imu.py --ab OLD_TREE NEW_TREE [--rounds 3]     (before / after, no peer)
     python benchmarks/bench_truth_imu.py --stages [--tree DIR]    (the truth and the IMU alone, one thread, no file)
 """
@@ -22,6 +23,7 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -101,7 +103,10 @@ def ours(tmp: Path, seconds: float, rate: float, runs: int = OUR_RUNS) -> tuple[
     for _ in range(runs):
         out.unlink(missing_ok=True)
         times.append(child([sys.executable, "-m", "simkit", "run", str(path), "-o", str(out), "-q"], cwd=ROOT)[:2])
-    return statistics.median(w for w, _ in times), statistics.median(c for _, c in times), out.stat().st_size
+    size = out.stat().st_size
+    out.unlink()  # not written back to disk while the peer runs
+    os.sync()
+    return statistics.median(w for w, _ in times), statistics.median(c for _, c in times), size
 
 
 def theirs(tmp: Path, checkout: Path, seconds: float, rate: float) -> tuple[float, float, int, int]:
@@ -110,6 +115,8 @@ def theirs(tmp: Path, checkout: Path, seconds: float, rate: float) -> tuple[floa
     out.mkdir()
     wall, cpu, stdout = child([sys.executable, "-c", PEER, str(checkout), str(seconds), str(rate), str(out)])
     size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    shutil.rmtree(out)  # its ~400 MB would otherwise be written back to disk during the next round's runs
+    os.sync()
     return wall, cpu, size, int(stdout.split()[-1])
 
 
@@ -135,17 +142,19 @@ def theirs_in_memory(pathgen, seconds: float, rate: float) -> float:
 
 
 BREAKDOWN = r"""
-import json, resource, sys, time
+import json, resource, sys, threading, time
 t_python = time.process_time()                      # the interpreter's own start-up (site, encodings)
 import simkit.cli
 simkit.cli.one_blas_thread()                        # as `simkit run` does, before numpy loads
 from simkit.heap import keep_freed_memory
 from simkit import pipeline
 from simkit.imu import simulator
+from simkit.io import writer
 from simkit.trajectory import generator
 t_imports = time.process_time() - t_python
 keep_freed_memory()                                 # as `simkit run` does
-lanes = {"truth": 0.0, "imu": 0.0}
+lanes = {"truth": 0.0, "imu": 0.0, "compression": 0.0, "compression_main": 0.0}
+lock = threading.Lock()
 
 
 def timed(name, fn):
@@ -154,27 +163,34 @@ def timed(name, fn):
         try:
             return fn(*args, **kwargs)
         finally:
-            lanes[name] += time.thread_time() - c
+            spent = time.thread_time() - c
+            with lock:
+                lanes[name] += spent
+                if name == "compression" and threading.current_thread() is threading.main_thread():
+                    lanes["compression_main"] += spent
     return run
 
 
 generator.Trajectory._integrate = timed("truth", generator.Trajectory._integrate)
 simulator.ImuSimulator.process = timed("imu", simulator.ImuSimulator.process)
+writer._deflated = timed("compression", writer._deflated)  # a first chunk's job calls it too
 w0, m0, p0 = time.perf_counter(), time.thread_time(), time.process_time()
 pipeline.run(sys.argv[1], sys.argv[2])
 main, process = time.thread_time() - m0, time.process_time() - p0
 ru = resource.getrusage(resource.RUSAGE_SELF)
 print(json.dumps({"python": t_python, "imports": t_imports, "run_wall": time.perf_counter() - w0, "run_cpu": process,
-                  "truth_thread": lanes["truth"], "imu": lanes["imu"], "write_main": main - lanes["imu"],
-                  "compression_pool": process - main - lanes["truth"], "user": ru.ru_utime, "system": ru.ru_stime,
-                  "minor_faults": ru.ru_minflt}))
+                  "truth": lanes["truth"], "imu": lanes["imu"], "compression": lanes["compression"],
+                  "compression_main": lanes["compression_main"],
+                  "rest_main": main - lanes["imu"] - lanes["compression_main"],
+                  "rest_workers": process - main - lanes["truth"] - (lanes["compression"] - lanes["compression_main"]),
+                  "user": ru.ru_utime, "system": ru.ru_stime, "minor_faults": ru.ru_minflt}))
 """
 
 
 def breakdown(tmp: Path, seconds: float, rate: float) -> dict:
     """Where one run's CPU goes, in a fresh interpreter (this checkout): the interpreter's start-up, the imports,
-    the truth (its worker thread), the IMU and the rest of the main thread (the HDF5 writes), the compression
-    pool; thread CPU times, user and system time, page faults."""
+    the truth (on the lane's worker), the IMU, the compression (on either thread) and the rest of each thread (the
+    HDF5 writes on the main thread); thread CPU times, user and system time, page faults."""
     path = tmp / "breakdown.toml"
     path.write_text(scenario(seconds, rate))
     _, _, stdout = child([sys.executable, "-c", BREAKDOWN, str(path), str(tmp / "breakdown.h5")], cwd=ROOT)
@@ -235,8 +251,16 @@ def ab(trees, seconds: float, rate: float, rounds: int) -> None:
         timing.ab(trees, AB_PROBE, ["wall s", "CPU s"], rounds, path, own_cache=True)
 
 
-def measure(seconds: float = 600.0, rate: float = 1000.0, peer: str | None = None) -> dict:
-    """Every figure of this benchmark, measured in this run (the peer's are None without a checkout)."""
+ROUNDS = 3  # rounds of (OUR_RUNS simkit runs, one peer run) when the peer is there: see measure()
+
+
+def measure(seconds: float = 600.0, rate: float = 1000.0, peer: str | None = None, rounds: int = ROUNDS) -> dict:
+    """Every figure of this benchmark, measured in this run (the peer's are None without a checkout).
+
+    With the peer, ``rounds`` rounds of (simkit's median of :data:`OUR_RUNS` runs, one peer run), interleaved: this
+    machine's speed drifts by ~10 % within minutes, so each ratio is taken between runs less than a minute apart,
+    and the figures are the medians over the rounds (the ratio: the median of the rounds' ratios), with every
+    round's figures kept in ``rounds``."""
     n = int(round(seconds * rate)) + 1
     load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="bench_truth_imu_") as tmp:
@@ -245,37 +269,51 @@ def measure(seconds: float = 600.0, rate: float = 1000.0, peer: str | None = Non
         # run: ~0.05 s), then the page cache warmed (not numba: a truth + IMU run does not import it)
         child([sys.executable, "-m", "compileall", "-q", str(ROOT / "simkit")], cwd=ROOT)
         child([sys.executable, "-m", "simkit", "run", "--help"], cwd=ROOT)
-        wall, cpu, size = ours(tmp, seconds, rate)
-        result = {"samples": n, "seconds": seconds, "rate_hz": rate, "load_before": load,
-                  "ours": {"wall_s": wall, "cpu_s": cpu, "bytes": size},
-                  "peer": None, "peer_in_memory_samples_per_s": None}
-        result["breakdown"] = breakdown(tmp, seconds, rate)
         pathgen = peers.gnss_ins_sim(peer)
-        if pathgen is not None:
-            checkout = Path(pathgen.__file__).resolve().parents[2]
-            pw, pc, psize, pn = theirs(tmp, checkout, seconds, rate)
-            result["peer"] = {"wall_s": pw, "cpu_s": pc, "bytes": psize, "samples": pn}
+        checkout = Path(pathgen.__file__).resolve().parents[2] if pathgen is not None else None
+        per_round = []
+        for k in range(rounds if checkout is not None else 1):
+            wall, cpu, size = ours(tmp, seconds, rate)
+            one = {"ours": {"wall_s": wall, "cpu_s": cpu, "bytes": size}, "peer": None}
+            if checkout is not None:
+                pw, pc, psize, pn = theirs(tmp, checkout, seconds, rate)
+                one["peer"] = {"wall_s": pw, "cpu_s": pc, "bytes": psize, "samples": pn}
+            per_round.append(one)
+        result = {"samples": n, "seconds": seconds, "rate_hz": rate, "load_before": load, "rounds": per_round,
+                  "ours": _medians([r["ours"] for r in per_round]), "peer": None, "peer_in_memory_samples_per_s": None}
+        result["breakdown"] = breakdown(tmp, seconds, rate)
+        if checkout is not None:
+            result["peer"] = _medians([r["peer"] for r in per_round])
             result["peer_in_memory_samples_per_s"] = theirs_in_memory(pathgen, min(seconds, 60.0), rate)
     result["load_after"] = os.getloadavg()[0]
     return result
 
 
+def _medians(figures: list[dict]) -> dict:
+    """Each figure's median over the rounds, and the ratios' inputs kept per round (``per_round``)."""
+    out = {key: statistics.median(f[key] for f in figures) for key in figures[0]}
+    out["per_round"] = figures
+    return out
+
+
 def report(r: dict) -> list[tuple[str, str, str, str]]:
-    """(figure, ours, peer, ratio) rows."""
+    """(figure, ours, peer, ratio) rows: the medians over the rounds, and the rounds' range of each ratio."""
     n = r["samples"]
-    o = r["ours"]
+    o, p = r["ours"], r["peer"]
+    rounds = len(o["per_round"])
     rows = [(f"truth + IMU, {r['seconds']:g} s at {r['rate_hz'] / 1000:g} kHz, start-up + write, wall (simkit: median "
-             f"of {OUR_RUNS} runs)",
+             f"of {OUR_RUNS} runs" + (f"; median of {rounds} interleaved rounds" if p is not None else "") + ")",
              f"{o['wall_s']:.2f} s ({n / o['wall_s']:,.0f} samples/s)"),
             ("truth + IMU, CPU (user + system)", f"{o['cpu_s']:.2f} s")]
     out = []
-    p = r["peer"]
     for (name, ours_text), key in zip(rows, ("wall_s", "cpu_s")):
         if p is None:
             out.append((name, ours_text, "peer absent", "-"))
             continue
-        ours_rate, peer_rate = n / o[key], p["samples"] / p[key]
-        out.append((name, ours_text, f"{p[key]:.1f} s ({peer_rate:,.0f} samples/s)", f"{ours_rate / peer_rate:.1f}x"))
+        ratios = [(n / w[key]) / (q["samples"] / q[key]) for w, q in zip(o["per_round"], p["per_round"])]
+        spread = f" (rounds {', '.join(f'{x:.1f}' for x in ratios)})" if rounds > 1 else ""
+        out.append((name, ours_text, f"{p[key]:.1f} s ({p['samples'] / p[key]:,.0f} samples/s)",
+                    f"{statistics.median(ratios):.1f}x{spread}"))
     if r["peer_in_memory_samples_per_s"]:
         peer_rate = r["peer_in_memory_samples_per_s"]
         out.append(("same, against the peer's generation alone (in memory, no start-up, no file; CPU)",
@@ -291,7 +329,8 @@ def main(argv=None) -> int:
     ap.add_argument("--peer", help="gnss-ins-sim checkout (default: $GNSS_INS_SIM)")
     ap.add_argument("--json", help="also write the figures as JSON to this file")
     ap.add_argument("--ab", nargs=2, metavar=("A", "B"), help="time two checkouts against each other instead")
-    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=ROUNDS,
+                    help="interleaved (simkit, peer) rounds; with --ab, alternations of the two trees")
     ap.add_argument("--stages", action="store_true", help="time the truth and the IMU alone instead")
     ap.add_argument("--tree", type=Path, default=ROOT, help="with --stages: the checkout to time (default: this one)")
     args = ap.parse_args(argv)
@@ -301,7 +340,7 @@ def main(argv=None) -> int:
     if args.ab:
         ab(args.ab, args.seconds, args.rate, args.rounds)
         return 0
-    r = measure(args.seconds, args.rate, args.peer)
+    r = measure(args.seconds, args.rate, args.peer, args.rounds)
     print(f"{r['samples']:,} samples ({args.seconds:g} s at {args.rate:g} Hz), load average "
           f"{r['load_before']:.2f} before, {r['load_after']:.2f} after; simkit file {r['ours']['bytes'] / 1e6:.0f} MB"
           + (f", gnss-ins-sim CSV {r['peer']['bytes'] / 1e6:.0f} MB" if r["peer"] else
@@ -309,9 +348,11 @@ def main(argv=None) -> int:
     timing.print_table(["figure", "simkit", "gnss-ins-sim", "ratio"], report(r))
     b = r["breakdown"]
     print(f"simkit's CPU, one more run in the same session (thread CPU s): interpreter {b['python']:.2f}, imports "
-          f"{b['imports']:.2f}, truth (worker thread) {b['truth_thread']:.2f}, IMU {b['imu']:.2f}, writes (main "
-          f"thread) {b['write_main']:.2f}, compression pool {b['compression_pool']:.2f}; run wall {b['run_wall']:.2f} s; "
-          f"process user {b['user']:.2f} + system {b['system']:.2f} s, {b['minor_faults']:,} page faults")
+          f"{b['imports']:.2f}, truth (lane worker) {b['truth']:.2f}, IMU {b['imu']:.2f}, compression "
+          f"{b['compression']:.2f} (of which {b['compression_main']:.2f} on the main thread while it waited), writes "
+          f"and the rest on the main thread {b['rest_main']:.2f}, on the worker {b['rest_workers']:.2f}; run wall "
+          f"{b['run_wall']:.2f} s; process user {b['user']:.2f} + system {b['system']:.2f} s, "
+          f"{b['minor_faults']:,} page faults")
     if args.json:
         Path(args.json).write_text(json.dumps(r, indent=1))
     return 0

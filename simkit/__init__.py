@@ -14,8 +14,8 @@ __all__ = ["__version__", "campaign", "open", "run", "score", "solve", "validate
 def run(scenario, out=None, seed=None, overrides=None, progress=False, force=False, threads=None):
     """Simulate ``scenario`` (a TOML path, a bundled name or a dict) into an HDF5 file; returns its Path.
 
-    ``threads``: threads compressing the output (1: on the calling thread; default ``$SIMKIT_NUM_THREADS``, else
-    up to 4, one per core)."""
+    ``threads``: threads sharing the work, the calling thread included (1: all of it on the calling thread;
+    default ``$SIMKIT_NUM_THREADS``, else up to 4, one per core)."""
     from .pipeline import run as _run
 
     return _run(scenario, out=out, seed=seed, overrides=overrides, progress=progress, force=force, threads=threads)

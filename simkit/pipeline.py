@@ -9,7 +9,6 @@ from __future__ import annotations
 import json
 from collections import deque
 from contextlib import contextmanager
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
@@ -21,7 +20,8 @@ from .errors import DataFileError, OutputError, ScenarioError
 from .heap import keep_freed_memory
 from .imu import ImuSimulator
 from .io.output import check_output
-from .io.writer import Writer, compression_threads
+from .io.writer import Writer
+from .lane import Lane, default_threads
 from .scenario import Scenario, load, resolve
 from .trajectory import Trajectory
 
@@ -50,8 +50,9 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
         force: bool = False, threads: int | None = None) -> Path:
     """Simulate a scenario into ``out`` (default ``<scenario name>.h5``); returns the output path.
 
-    ``threads``: threads compressing the output (1: on the calling thread; default
-    :func:`simkit.io.writer.compression_threads`).
+    ``threads``: threads sharing the work, the calling thread included (1: all of it on the calling thread;
+    default :func:`simkit.lane.default_threads`): the truth computed ahead and the output's compression run on
+    the others, and on the calling thread while it waits for them.
 
     Everything that can be checked is checked before the first sample: the scenario, the constellation sources
     and their coverage of the run, the output path (an existing file is replaced only when it is a simkit file
@@ -69,13 +70,13 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
                           f" GiB; scenario.duration_s = {sc.duration_s:g}); --force to run it anyway")
     source = None if isinstance(scenario, dict) else _scenario_file(scenario)
     check_output(out, inputs=[source, *sc.inputs], estimated_bytes=size, force=force, simkit_only=True)
-    threads = compression_threads() if threads is None else threads
+    threads = default_threads() if threads is None else threads
     traj = Trajectory(sc.trajectory, sc.duration_s)
-    # the truth starts now, on its worker, while the IMU and GNSS stages are built and h5py loads
-    with _truth_lane(traj.blocks(block_samples=block_samples), ahead=threads > 1) as truth:
+    # the truth starts now, on the lane, while the IMU and GNSS stages are built and h5py loads
+    with Lane(threads - 1) as lane, _truth_lane(traj.blocks(block_samples=block_samples), lane) as truth:
         stages = build(sc, sky, traj)
-        with Writer(out, root_attributes(sc), threads) as w:
-            _write(w, sc, stages, truth, progress, ahead=threads > 1, imu_ahead=TRUTH_AHEAD * block_samples)
+        with Writer(out, root_attributes(sc), lane=lane) as w:
+            _write(w, sc, stages, truth, progress, ahead=lane.workers > 0, imu_ahead=TRUTH_AHEAD * block_samples)
     return out
 
 
@@ -240,33 +241,29 @@ def _write_static(w: Writer, sc: Scenario, stages: Stages) -> None:
 
 
 @contextmanager
-def _truth_lane(blocks: Iterator, ahead: bool, depth: int = TRUTH_AHEAD) -> Iterator[Iterator]:
-    """The truth blocks as an iterator, computed on a worker thread from the moment the context opens and up to
-    ``depth`` blocks ahead of the reader (numpy releases the GIL in its loops, so the truth, the IMU + writes and
-    the compression share the cores; one block ahead left the worker idle while the reader waited for the
-    compression); in order, as computed alone. ``ahead`` False: computed by the reader, on its thread."""
-    if not ahead:
+def _truth_lane(blocks: Iterator, lane: Lane, depth: int = TRUTH_AHEAD) -> Iterator[Iterator]:
+    """The truth blocks as an iterator, computed on ``lane`` from the moment the context opens and up to ``depth``
+    blocks ahead of the reader (numpy releases the GIL in its loops, so the truth, the IMU + writes and the
+    compression share the cores; while the reader waits for a block, it compresses); in order, as computed
+    alone. A lane without workers: computed by the reader, on its thread."""
+    if not lane.workers:
         yield blocks
         return
-    worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="simkit-truth")  # one thread: in order
-    queued = deque(worker.submit(next, blocks, None) for _ in range(depth))
+    queued = deque(lane.submit(next, blocks, None, key="truth") for _ in range(depth))
 
     def read() -> Iterator:
-        while (block := queued.popleft().result()) is not None:
-            queued.append(worker.submit(next, blocks, None))
+        while (block := lane.wait(queued.popleft())) is not None:
+            queued.append(lane.submit(next, blocks, None, key="truth"))
             yield block
 
-    try:
-        yield read()
-    finally:
-        worker.shutdown(wait=True, cancel_futures=True)
+    yield read()
 
 
 def _write(w: Writer, sc: Scenario, stages: Stages, truth: Iterator, progress: bool, ahead: bool = False,
            imu_ahead: int = 0) -> None:
     """Every block of the run into ``w``: truth and IMU rows per ``truth`` block, then the GNSS epochs of each block
     (``ahead``: the next GNSS slice's geometry on a worker thread, and the IMU noise of the first ``imu_ahead``
-    samples drawn while the truth worker computes the first blocks: this thread would wait for them idle)."""
+    samples drawn while the lane computes the first truth blocks: this thread would wait for them idle)."""
     _write_static(w, sc, stages)
     if ahead and stages.imu is not None:
         stages.imu.draw_ahead(min(imu_ahead, stages.trajectory.n_samples()))

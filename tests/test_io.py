@@ -165,7 +165,7 @@ def test_package_import_graph_is_acyclic():
 # used by attitude (ATDOP), ambiguity needs nothing but errors.
 LAYERS = [
     {"errors", "version", "atomic", "rng", "gpstime", "processes", "earth", "solution", "quat", "jitcache", "heap"},
-    {"frames", "section", "params"},
+    {"frames", "section", "params", "lane"},
     {"trajectory", "imu", "constellation", "environment"},
     {"gnss"},
     {"io"},

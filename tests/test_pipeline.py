@@ -19,7 +19,7 @@ def _arrays(path):
 
 
 def test_same_scenario_and_seed_give_identical_arrays(tmp_path):
-    """Also when one run compresses on its own thread (as campaign runs do) and the other in a thread pool."""
+    """Also when one run compresses on its own thread (as campaign runs do) and the other on a lane of workers."""
     a = simkit.run("quickstart", out=tmp_path / "a.h5", overrides=["scenario.duration_s=20"])
     b = simkit.run("quickstart", out=tmp_path / "b.h5", overrides=["scenario.duration_s=20"], threads=1)
     xa, xb = _arrays(a), _arrays(b)

@@ -1,4 +1,4 @@
-"""The lanes of a run (issue 25): the truth computed ahead on its worker thread, the writer's bounded queue of chunks
+"""The lanes of a run (issue 25): the truth computed ahead on the lane's workers, the writer's bounded queue of chunks
 being compressed, and the command's exit without the interpreter's teardown."""
 import subprocess
 import sys
@@ -22,9 +22,10 @@ def _arrays(path):
     return out
 
 
-def test_truth_ahead_and_small_queue_give_the_arrays_of_one_thread(tmp_path, monkeypatch):
+@pytest.mark.parametrize("threads", [2, 3])
+def test_truth_ahead_and_small_queue_give_the_arrays_of_one_thread(tmp_path, monkeypatch, threads):
     """Many blocks (300 samples) with the truth two blocks ahead and a compression queue of a few chunks give the
-    arrays of a run on one thread, in order."""
+    arrays of a run on one thread, in order, with one worker or two (the truth blocks then run on either)."""
     scenario = truth_imu_toml(tmp_path, 12.0)
     one = simkit.pipeline.run(scenario, out=tmp_path / "one.h5", block_samples=300, threads=1)
     held = []
@@ -37,7 +38,7 @@ def test_truth_ahead_and_small_queue_give_the_arrays_of_one_thread(tmp_path, mon
     monkeypatch.setattr(writer, "IN_FLIGHT_BYTES", 3 * 8 * 8192)
     monkeypatch.setattr(writer, "CHUNK_ROWS", 512)
     monkeypatch.setattr(writer.Writer, "_drain", watched)
-    many = simkit.pipeline.run(scenario, out=tmp_path / "many.h5", block_samples=300, threads=2)
+    many = simkit.pipeline.run(scenario, out=tmp_path / "many.h5", block_samples=300, threads=threads)
     a, b = _arrays(one), _arrays(many)
     assert a.keys() == b.keys() and len(a["truth/t"]) == 1201
     for k in a:
@@ -60,7 +61,7 @@ def test_a_failing_truth_block_stops_the_run_and_its_worker(tmp_path, monkeypatc
     with pytest.raises(RuntimeError, match="third block"):
         pipeline.run(scenario, out=tmp_path / "x.h5", block_samples=100, threads=2)
     assert len(calls) == 3                                  # nothing asked of the generator after its failure
-    assert not [t for t in threading.enumerate() if t.name.startswith("simkit-truth")]
+    assert not [t for t in threading.enumerate() if t.name.startswith("simkit-lane")]
     assert not list(tmp_path.glob("*.h5*"))                 # no output, no temporary
 
 

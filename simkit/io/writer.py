@@ -1,9 +1,10 @@
 """Writing the simkit HDF5 file (schema v1: :mod:`.schema`, README "HDF5 layout"): chunked, gzip-compressed, appended in time blocks.
 
-Time series are compressed chunk by chunk in a thread pool (byte shuffle + deflate in zlib format, which is what
-HDF5's shuffle and deflate filters read, so any HDF5 reader decodes them; the byte planes that do not compress are
-stored in the deflate stream as they are: :mod:`.shuffle_deflate`) and stored with direct chunk writes. Deflate
-releases the GIL, so compression runs beside the simulation. The file is written under a temporary name
+Time series are compressed chunk by chunk by the threads of a :class:`simkit.lane.Lane`, the writing thread too
+while it waits for them (byte shuffle + deflate in zlib format, which is what HDF5's shuffle and deflate filters
+read, so any HDF5 reader decodes them; the byte planes that do not compress are stored in the deflate stream as they
+are: :mod:`.shuffle_deflate`) and stored with direct chunk writes. Deflate releases the GIL, so compression runs
+beside the simulation. The file is written under a temporary name
 in the destination folder and renamed only when complete, so an interrupted run never leaves a truncated file
 under the output name.
 """
@@ -12,7 +13,7 @@ from __future__ import annotations
 import json
 import os
 from collections import deque
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..atomic import remove_stale_temporaries, temporary_name
-from ..errors import ScenarioError
+from ..lane import Lane, default_threads
 from ..version import __version__
 from . import schema
 from .schema import SCHEMA_VERSION
@@ -85,37 +86,12 @@ class _Series:
         self.probe: Future | None = None  # the first chunk's job, until that decision is read from it
 
 
-THREADS_ENV = "SIMKIT_NUM_THREADS"
-
-
-def compression_threads() -> int:
-    """Default number of threads that compress chunks: ``$SIMKIT_NUM_THREADS`` when set (1: compress on the
-    calling thread), else up to 4, one per core. Campaign runs use 1: there the runs are the parallelism."""
-    value = os.environ.get(THREADS_ENV, "").strip()
-    if value:
-        if not value.isdigit() or int(value) < 1:
-            raise ScenarioError(f"${THREADS_ENV}", f"{value!r}; expected a positive integer (compression threads)")
-        return int(value)
-    return max(1, min(4, os.cpu_count() or 1))
-
-
-class _Inline:
-    """The executor interface, running each job at once on the calling thread."""
-
-    @staticmethod
-    def submit(fn, *args) -> Future:
-        done = Future()
-        done.set_result(fn(*args))
-        return done
-
-    def shutdown(self, wait=True, cancel_futures=False) -> None:
-        pass
-
-
 class Writer:
     """Context manager writing one simkit file; ``append`` grows time series block by block."""
 
-    def __init__(self, path: str | Path, attrs: dict, threads: int | None = None):
+    def __init__(self, path: str | Path, attrs: dict, threads: int | None = None, lane: Lane | None = None):
+        """``lane``: the threads that compress (the caller's own, shared with other work); without one, the writer
+        has its own of ``threads`` threads, this one included (default :func:`simkit.lane.default_threads`)."""
         self.path = Path(path)
         self.tmp = temporary_name(self.path)
         self.attrs = attrs
@@ -123,8 +99,8 @@ class Writer:
         self._series: dict[str, _Series] = {}
         self._jobs: deque = deque()  # (dataset, offset, job, filter mask or None, bytes held), in order
         self._held = 0               # bytes of the chunks in self._jobs
-        threads = compression_threads() if threads is None else threads
-        self._pool = _Inline() if threads == 1 else ThreadPoolExecutor(max_workers=threads)
+        self._own_lane = lane is None
+        self._lane = Lane((default_threads() if threads is None else threads) - 1) if lane is None else lane
 
     def __enter__(self) -> "Writer":
         remove_stale_temporaries(self.path)
@@ -148,7 +124,8 @@ class Writer:
                     series.ds.resize(series.n_total, axis=0)
                     self._flush(series, final=True)
                 self._drain(0)
-            self._pool.shutdown(wait=True, cancel_futures=True)
+            if self._own_lane:
+                self._lane.shutdown(wait=True, cancel_futures=True)
             self.file.close()
         finally:
             if exc_type is None:
@@ -221,18 +198,18 @@ class Writer:
         its rows before the zero padding of the last chunk). The first chunk is tried in the pool too; the series
         waits for that answer only at its second chunk."""
         if series.raw is None and series.probe is not None:
-            series.raw = series.probe.result()[1] == SKIP_FILTERS
+            series.raw = self._lane.wait(series.probe)[1] == SKIP_FILTERS
             series.probe = None
         if series.raw:  # written at once from the array itself, ahead of chunks still compressing (any order)
             series.ds.id.write_direct_chunk(offset, chunk, filter_mask=SKIP_FILTERS)
             return
-        if not (own or isinstance(self._pool, _Inline)):
+        if not own and self._lane.workers:  # a job of a lane without workers runs before submit returns
             chunk = chunk.copy()
         if series.raw is None:
-            series.probe = self._pool.submit(_first_chunk, chunk, valid)
+            series.probe = self._lane.submit(_first_chunk, chunk, valid)
             self._jobs.append((series.ds, offset, series.probe, None, chunk.nbytes))
         else:
-            self._jobs.append((series.ds, offset, self._pool.submit(_deflated, chunk, valid), 0,
+            self._jobs.append((series.ds, offset, self._lane.submit(_deflated, chunk, valid), 0,
                                chunk.nbytes))
         self._held += chunk.nbytes
 
@@ -240,7 +217,7 @@ class Writer:
         """Write finished chunks in order, keeping at most ``keep`` bytes of chunks in flight (bounds memory)."""
         while self._jobs and (self._held > keep or self._jobs[0][2].done()):
             ds, offset, job, mask, held = self._jobs.popleft()
-            data, mask = job.result() if mask is None else (job.result(), mask)  # None: a first chunk's job
+            data, mask = self._lane.wait(job) if mask is None else (self._lane.wait(job), mask)  # None: a first chunk's job
             if data is not None:
                 ds.id.write_direct_chunk(offset, data, filter_mask=mask)
             self._held -= held
