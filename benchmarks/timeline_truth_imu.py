@@ -2,7 +2,7 @@
 
 Runs ``python -m simkit run`` of :func:`bench_truth_imu.scenario` in a fresh interpreter with its stages wrapped
 (the truth blocks on their worker thread, the IMU and the writer's calls on the main thread, each compression job
-on its pool thread, the file's close) and prints, for each lane, its busy spans and CPU, then a strip chart in bins
+on the thread that ran it: a pool thread, a lane worker or the main thread while it waits, the file's close) and prints, for each lane, its busy spans and CPU, then a strip chart in bins
 of wall time from the process start, the idle gaps and the serial head (before the first truth block ends) and tail
 (after the last IMU block ends).
 
@@ -38,7 +38,7 @@ def timed(lane, label, fn):
         try:
             return fn(*args, **kwargs)
         finally:
-            name = lane if lane != "pool" else threading.current_thread().name
+            name = lane if lane != "pool" else "compress@" + threading.current_thread().name
             spans.append((name, label, w, time.perf_counter(), time.thread_time() - c))
     return run
 

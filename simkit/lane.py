@@ -1,11 +1,11 @@
 """The threads that share a run's work: :class:`Lane`, worker threads fed in submission order, whose jobs a thread
 waiting for a result runs itself.
 
-A run has three kinds of work beside the caller's own (the IMU, the GNSS observables, the HDF5 writes): the truth
+A run has two kinds of work beside the caller's own (the IMU, the GNSS observables, the HDF5 writes): the truth
 blocks, computed ahead, and the compression of the output's chunks. With one pool for each, a 2-core machine ran
-four threads and the caller still waited, idle, for a truth block queued behind compression. In one lane, a
-thread that waits (:meth:`Lane.wait`) compresses meanwhile: the two cores stay busy to the end
-(``benchmarks/bench_truth_imu.py``: 0.62 -> 0.59 s wall, docs/benchmarks.md).
+four threads and the caller still waited, idle, for the next truth block. In one lane, a thread that waits
+(:meth:`Lane.wait`) compresses meanwhile: two threads, both busy to the end (600 s of truth + IMU at 1 kHz: 0.605 ->
+0.555 s wall in same-run pairs, docs/benchmarks.md).
 
 Jobs with a ``key`` (the truth, whose generator must advance in order) run only on the workers, one at a time per
 key, in submission order; jobs without one (compression) run on whichever thread takes them first.
