@@ -9,9 +9,10 @@ interpreter: ``ins_sim.Sim`` on a motion profile of turns, 200 deg/s rolls and a
 rate, with the STIM300's bias, ARW/VRW and bias instability (first-order Gauss-Markov, its model), ``run()`` and
 ``results(dir)``, its own output (CSV files). Both are timed as child processes: wall time and CPU time
 (user + system of the child, so threads count), in interleaved rounds (simkit's median of 5 runs, then one peer
-run; 3 rounds): the ratio is the median of the rounds' ratios, each round's printed beside it. Also printed: the peer's generation alone in memory (``path_gen``
-+ ``gyro_gen`` + ``acc_gen``, no start-up, no file), the strictest comparison, and where simkit's CPU goes (one
-more run, instrumented: start-up, imports, truth, IMU, compression, writes).
+run; 3 rounds): the ratio is the median of the rounds' ratios, each round's printed beside it. Also printed: the
+peer's generation alone in memory (``path_gen`` + ``gyro_gen`` + ``acc_gen``, no start-up, no file), the strictest
+comparison, and where simkit's CPU goes (one more run, instrumented: start-up, imports, truth, IMU, compression,
+writes).
 
     python benchmarks/bench_truth_imu.py [--seconds 600] [--rate 1000] [--peer DIR] [--rounds 3] [--json OUT]
     python benchmarks/bench_truth_imu.py --ab OLD_TREE NEW_TREE [--rounds 3]     (before / after, no peer)

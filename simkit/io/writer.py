@@ -194,8 +194,8 @@ class Writer:
 
     def _encode(self, series: _Series, chunk: np.ndarray, offset: tuple, own: bool, valid: int) -> None:
         """Write the chunk raw now when the series' first chunk showed that deflating does not pay, else queue it
-        for compression in the pool (``own``: ``chunk`` is the writer's; otherwise the pool gets a copy; ``valid``:
-        its rows before the zero padding of the last chunk). The first chunk is tried in the pool too; the series
+        for compression on the lane (``own``: ``chunk`` is the writer's; otherwise the lane gets a copy; ``valid``:
+        its rows before the zero padding of the last chunk). The first chunk is tried on the lane too; the series
         waits for that answer only at its second chunk."""
         if series.raw is None and series.probe is not None:
             series.raw = self._lane.wait(series.probe)[1] == SKIP_FILTERS
@@ -217,7 +217,9 @@ class Writer:
         """Write finished chunks in order, keeping at most ``keep`` bytes of chunks in flight (bounds memory)."""
         while self._jobs and (self._held > keep or self._jobs[0][2].done()):
             ds, offset, job, mask, held = self._jobs.popleft()
-            data, mask = self._lane.wait(job) if mask is None else (self._lane.wait(job), mask)  # None: a first chunk's job
+            data = self._lane.wait(job)
+            if mask is None:  # a first chunk's job: (what to store, its filter mask)
+                data, mask = data
             if data is not None:
                 ds.id.write_direct_chunk(offset, data, filter_mask=mask)
             self._held -= held
