@@ -281,27 +281,25 @@ def measure(seconds: float = 600.0, rate: float = 1000.0, peer: str | None = Non
                 one["peer"] = {"wall_s": pw, "cpu_s": pc, "bytes": psize, "samples": pn}
             per_round.append(one)
         result = {"samples": n, "seconds": seconds, "rate_hz": rate, "load_before": load, "rounds": per_round,
-                  "ours": _medians([r["ours"] for r in per_round]), "peer": None, "peer_in_memory_samples_per_s": None}
+                  "ours": _median([r["ours"] for r in per_round]), "peer": None, "peer_in_memory_samples_per_s": None}
         result["breakdown"] = breakdown(tmp, seconds, rate)
         if checkout is not None:
-            result["peer"] = _medians([r["peer"] for r in per_round])
+            result["peer"] = _median([r["peer"] for r in per_round])
             result["peer_in_memory_samples_per_s"] = theirs_in_memory(pathgen, min(seconds, 60.0), rate)
     result["load_after"] = os.getloadavg()[0]
     return result
 
 
-def _medians(figures: list[dict]) -> dict:
-    """Each figure's median over the rounds, and the ratios' inputs kept per round (``per_round``)."""
-    out = {key: statistics.median(f[key] for f in figures) for key in figures[0]}
-    out["per_round"] = figures
-    return out
+def _median(figures: list[dict]) -> dict:
+    """Each figure's median over the rounds."""
+    return {key: statistics.median(f[key] for f in figures) for key in figures[0]}
 
 
 def report(r: dict) -> list[tuple[str, str, str, str]]:
-    """(figure, ours, peer, ratio) rows: the medians over the rounds, and the rounds' range of each ratio."""
+    """(figure, ours, peer, ratio) rows: the medians over the rounds, and each round's ratio."""
     n = r["samples"]
     o, p = r["ours"], r["peer"]
-    rounds = len(o["per_round"])
+    rounds = len(r["rounds"])
     rows = [(f"truth + IMU, {r['seconds']:g} s at {r['rate_hz'] / 1000:g} kHz, start-up + write, wall (simkit: median "
              f"of {OUR_RUNS} runs" + (f"; median of {rounds} interleaved rounds" if p is not None else "") + ")",
              f"{o['wall_s']:.2f} s ({n / o['wall_s']:,.0f} samples/s)"),
@@ -311,7 +309,7 @@ def report(r: dict) -> list[tuple[str, str, str, str]]:
         if p is None:
             out.append((name, ours_text, "peer absent", "-"))
             continue
-        ratios = [(n / w[key]) / (q["samples"] / q[key]) for w, q in zip(o["per_round"], p["per_round"])]
+        ratios = [(n / one["ours"][key]) / (one["peer"]["samples"] / one["peer"][key]) for one in r["rounds"]]
         spread = f" (rounds {', '.join(f'{x:.1f}' for x in ratios)})" if rounds > 1 else ""
         out.append((name, ours_text, f"{p[key]:.1f} s ({p['samples'] / p[key]:,.0f} samples/s)",
                     f"{statistics.median(ratios):.1f}x{spread}"))

@@ -70,12 +70,14 @@ def earth_rate_enu(lat, sin_lat=None, cos_lat=None):
     return out
 
 
+def transport_rate(lat, h, v_east, v_north, sin_lat=None):
+    """Transport rate w_en^n by component: its E, N and U arrays (rad/s) for the east and north velocity (m/s,
+    relative to Earth); the truth's form, contiguous arrays rather than an (N, 3) one."""
+    rm, rn = radii(lat, sin_lat)
+    return -v_north / (rm + h), v_east / (rn + h), v_east * np.tan(lat) / (rn + h)
+
+
 def transport_rate_enu(lat, h, vel_enu, sin_lat=None):
     """Transport rate w_en^n in ENU, (..., 3) rad/s, for velocity ``vel_enu`` (m/s, relative to Earth)."""
-    rm, rn = radii(lat, sin_lat)
     v = np.asarray(vel_enu, dtype=float)
-    out = np.empty(v.shape)
-    out[..., 0] = -v[..., 1] / (rm + h)
-    out[..., 1] = v[..., 0] / (rn + h)
-    out[..., 2] = v[..., 0] * np.tan(lat) / (rn + h)
-    return out
+    return np.stack(transport_rate(lat, h, v[..., 0], v[..., 1], sin_lat), axis=-1)

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 from collections import deque
-from contextlib import contextmanager
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
@@ -73,7 +72,8 @@ def run(scenario, out=None, seed=None, overrides=None, progress=False, block_sam
     threads = default_threads() if threads is None else threads
     traj = Trajectory(sc.trajectory, sc.duration_s)
     # the truth starts now, on the lane, while the IMU and GNSS stages are built and h5py loads
-    with Lane(threads - 1) as lane, _truth_lane(traj.blocks(block_samples=block_samples), lane) as truth:
+    with Lane(threads - 1) as lane:
+        truth = _truth_blocks(traj.blocks(block_samples=block_samples), lane)
         stages = build(sc, sky, traj)
         with Writer(out, root_attributes(sc), lane=lane) as w:
             _write(w, sc, stages, truth, progress, ahead=lane.workers > 0, imu_ahead=TRUTH_AHEAD * block_samples)
@@ -240,15 +240,14 @@ def _write_static(w: Writer, sc: Scenario, stages: Stages) -> None:
             w.write(path, data)
 
 
-@contextmanager
-def _truth_lane(blocks: Iterator, lane: Lane, depth: int = TRUTH_AHEAD) -> Iterator[Iterator]:
-    """The truth blocks as an iterator, computed on ``lane`` from the moment the context opens and up to ``depth``
-    blocks ahead of the reader (numpy releases the GIL in its loops, so the truth, the IMU + writes and the
-    compression share the cores; while the reader waits for a block, it compresses); in order, as computed
-    alone. A lane without workers: computed by the reader, on its thread."""
+def _truth_blocks(blocks: Iterator, lane: Lane, depth: int = TRUTH_AHEAD) -> Iterator:
+    """The truth blocks as an iterator, computed on ``lane`` from this call on and up to ``depth`` blocks ahead of
+    the reader (numpy releases the GIL in its loops, so the truth, the IMU + writes and the compression share the
+    cores; while the reader waits for a block, it compresses); in order, as computed alone. A lane without workers:
+    ``blocks`` itself, computed by the reader on its thread. Jobs still queued when the run stops early are the
+    lane's to cancel."""
     if not lane.workers:
-        yield blocks
-        return
+        return blocks
     queued = deque(lane.submit(next, blocks, None, key="truth") for _ in range(depth))
 
     def read() -> Iterator:
@@ -256,7 +255,7 @@ def _truth_lane(blocks: Iterator, lane: Lane, depth: int = TRUTH_AHEAD) -> Itera
             queued.append(lane.submit(next, blocks, None, key="truth"))
             yield block
 
-    yield read()
+    return read()
 
 
 def _write(w: Writer, sc: Scenario, stages: Stages, truth: Iterator, progress: bool, ahead: bool = False,

@@ -156,11 +156,10 @@ class Trajectory:
                accel * (cg * cp) + v_gamma * (-sg * cp) + v_psi * (-cg * sp),
                accel * sg + v_gamma * cg)
 
-        # earth.earth_rate_enu, earth.transport_rate_enu and f^n = dv/dt + (2 w_ie + w_en) x v - g^n, by component
+        # earth.earth_rate_enu and f^n = dv/dt + (2 w_ie + w_en) x v - g^n, by component
         ve, vn, vu = vel
-        rm, _ = earth.radii(lat, sin_lat)
         w_ie_n, w_ie_u = earth.OMEGA_E * cos_lat, earth.OMEGA_E * sin_lat
-        w_en = (-vn / (rm + hgt), ve / (rn + hgt), ve * np.tan(lat) / (rn + hgt))
+        w_en = earth.transport_rate(lat, hgt, ve, vn, sin_lat)
         o_e, o_n, o_u = w_en[0], 2.0 * w_ie_n + w_en[1], 2.0 * w_ie_u + w_en[2]
         f_n = (acc[0] + (o_n * vu - o_u * vn), acc[1] + (o_u * ve - o_e * vu),
                acc[2] + (o_e * vn - o_n * ve) + earth.normal_gravity(lat, hgt, sin_lat))
